@@ -1,0 +1,1 @@
+"""gfe-opt: finite-element model updating with generic elements and physical realisation."""

@@ -1,0 +1,100 @@
+r"""Modal analysis: the lowest eigenpairs of :math:`K φ = ω^2 M φ` by sparse shift-invert.
+
+Conditioning: beam DOFs mix translations and rotations and the stiffness spans many decades
+on fine meshes, so the free-DOF matrices are first scaled symmetrically,
+:math:`\tilde K = D K D`, :math:`\tilde M = D M D` with :math:`D = \mathrm{diag}(M)^{-1/2}`,
+and the shift is placed *below* the spectrum at :math:`σ = -λ_{ref}` where
+:math:`λ_{ref}` is the model's natural eigenvalue scale (EI/(ρA L⁴) for a beam, EA/(ρA L²)
+for a bar).  A negative shift keeps :math:`\tilde K - σ \tilde M` positive definite, so
+free–free structures (rigid-body modes at ω = 0) need no special case.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .assembly import Discretisation, discretise
+from .errors import GfeSolverError
+from .model import Model
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Natural frequencies [Hz] and mass-normalised shapes (n_dof, n_modes), all DOFs."""
+
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Circular frequencies [rad/s]."""
+        return 2.0 * np.pi * self.frequencies_hz
+
+    @property
+    def n_modes(self) -> int:
+        return len(self.frequencies_hz)
+
+
+def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | None = None):
+    """Lowest ``n_modes`` eigenpairs of the sparse pencil (K, M) with DOFs ``constrained`` fixed.
+
+    Returns :class:`Modes` with shapes expanded to all DOFs (zeros at constrained ones),
+    mass-normalised, sign fixed so that the largest-magnitude entry is positive.
+    """
+    n = K.shape[0]
+    free = np.setdiff1d(np.arange(n), np.asarray(constrained, dtype=int))
+    if n_modes < 1 or n_modes > len(free) - 1:
+        raise ValueError(f"n_modes must lie in [1, {len(free) - 1}], got {n_modes}")
+    Kf = sp.csc_matrix(K)[free][:, free]
+    Mf = sp.csc_matrix(M)[free][:, free]
+    dm = Mf.diagonal()
+    dk = Kf.diagonal()
+    if eigenvalue_scale is None:
+        eigenvalue_scale = 1e-8 * float(np.max(dk / np.where(dm > 0, dm, np.inf)))
+    d = np.where(dm > 0, 1.0 / np.sqrt(np.where(dm > 0, dm, 1.0)),
+                 1.0 / np.sqrt(np.maximum(dk, 1e-300) / eigenvalue_scale))
+    D = sp.diags(d)
+    Ks = (D @ Kf @ D).tocsc()
+    Ms = (D @ Mf @ D).tocsc()
+    sigma = -eigenvalue_scale
+    try:
+        if len(free) <= 60:
+            import scipy.linalg as sla
+
+            lam, vec = sla.eigh(Ks.toarray(), Ms.toarray())
+            lam, vec = lam[:n_modes], vec[:, :n_modes]
+        else:
+            lu = spla.splu((Ks - sigma * Ms).tocsc())
+            op = spla.LinearOperator(Ks.shape, matvec=lu.solve, dtype=float)
+            lam, vec = spla.eigsh(Ks, k=n_modes, M=Ms, sigma=sigma, which="LM", OPinv=op,
+                                  tol=1e-12)
+    except (RuntimeError, spla.ArpackError, np.linalg.LinAlgError) as exc:
+        raise GfeSolverError(f"eigen solve failed: {exc}") from exc
+    order = np.argsort(lam)
+    lam, vec = lam[order], vec[:, order]
+    lam = np.where(np.abs(lam) < 1e-9 * eigenvalue_scale, 0.0, lam)
+    if np.any(lam < 0):
+        raise GfeSolverError(f"eigen solve returned negative eigenvalues {lam[lam < 0]}: "
+                             "stiffness is not positive semidefinite")
+    shapes = np.zeros((n, n_modes))
+    shapes[free] = d[:, None] * vec
+    gen_mass = np.einsum("ij,ij->j", shapes, M @ shapes)
+    shapes /= np.sqrt(gen_mass)
+    peak = np.argmax(np.abs(shapes), axis=0)
+    shapes *= np.sign(shapes[peak, np.arange(n_modes)])
+    return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=shapes)
+
+
+def discretisation_modes(disc: Discretisation, n_modes: int, params=None) -> Modes:
+    """Modes of a discretisation, optionally with replaced generic stiffness parameters."""
+    K, M = disc.global_matrices(params)
+    return solve_modes(K, M, n_modes, disc.constrained, disc.eigenvalue_scale)
+
+
+def model_modes(model: Model, n_modes: int) -> Modes:
+    """The lowest ``n_modes`` modes of a model (all its effects included)."""
+    return discretisation_modes(discretise(model), n_modes)

@@ -1,0 +1,328 @@
+"""Model files (TOML, SI units): a beam or bar, its material, section, supports and effects.
+
+The file form is a contract (see README, "Model file")::
+
+    name = "ss-steel-beam"
+    kind = "beam"            # "beam" (transverse w, rotation) or "bar" (axial u)
+    length = 0.575           # m
+    elements = 46
+    [material]
+    E = 206e9                # Pa
+    rho = 7800               # kg/m^3
+    nu = 0.3
+    [section]
+    shape = "rectangle"      # or give A (m^2) and I (m^4) directly
+    b = 0.009525             # m, breadth
+    h = 0.03175              # m, depth
+    [supports]
+    left = "pinned"          # pinned | clamped | free | sliding (bar: fixed | free)
+    right = "pinned"
+    [[effects]]              # optional, any number
+    effect = "crack"
+    position = 0.19
+    depth_ratio = 0.5
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from .errors import GfeInputError
+
+BEAM_SUPPORTS = ("pinned", "clamped", "free", "sliding")
+BAR_SUPPORTS = ("fixed", "free")
+BEAM_MASS_MODELS = ("consistent", "higher_order", "lumped")
+BAR_MASS_MODELS = ("consistent", "lumped", "harmonic", "minimum_error")
+
+#: Effect names and their parameter keys (a contract shared with model files and the CLI).
+#: Each entry: parameter -> (unit, kind) with kind "positive", "real", "fraction" or "side".
+EFFECT_PARAMETERS: dict[str, dict[str, tuple[str, str]]] = {
+    "material": {"E": ("Pa", "positive")},
+    "crack": {"position": ("m", "position"), "depth_ratio": ("-", "fraction")},
+    "shear": {"shear_rigidity": ("N", "positive")},
+    "axial_load": {"tension": ("N", "real")},
+    "foundation": {"stiffness": ("N/m^2", "positive")},
+    "support_spring": {"stiffness": ("N m/rad", "positive"), "side": ("", "side")},
+    "point_mass": {"position": ("m", "position"), "mass": ("kg", "positive")},
+}
+#: Effects that only make sense for a beam (transverse bending).
+BEAM_ONLY_EFFECTS = ("crack", "shear", "axial_load", "foundation", "support_spring")
+SPRING_SIDES = ("left", "right", "both")
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A physical effect present in a model: its name and physical parameters (SI)."""
+
+    name: str
+    parameters: dict[str, Any]
+
+    def __str__(self) -> str:
+        args = ", ".join(f"{k}={_fmt(v)}" for k, v in self.parameters.items())
+        return f"{self.name}({args})"
+
+
+def _fmt(v):
+    return f"{v:.6g}" if isinstance(v, float) else str(v)
+
+
+@dataclass(frozen=True)
+class Model:
+    """A uniform beam or bar discretised into equal elements, with optional effects.
+
+    Attributes are SI: ``length`` [m], ``E`` [Pa], ``rho`` [kg/m³], ``area`` A [m²],
+    ``inertia`` I [m⁴]; ``depth`` h [m] is known for rectangular sections (cracks need it).
+    """
+
+    name: str
+    kind: str
+    length: float
+    elements: int
+    E: float
+    rho: float
+    nu: float
+    area: float
+    inertia: float
+    supports: tuple[str, str]
+    depth: float | None = None
+    breadth: float | None = None
+    mass_model: str = "consistent"
+    effects: tuple[Effect, ...] = field(default_factory=tuple)
+    source: str | None = None
+
+    # -- derived quantities -----------------------------------------------------------
+    @property
+    def youngs_modulus(self) -> float:
+        """E, overridden by a ``material`` effect when present."""
+        for e in self.effects:
+            if e.name == "material":
+                return float(e.parameters["E"])
+        return self.E
+
+    @property
+    def bending_rigidity(self) -> float:
+        """EI [N m²] of the undamaged section."""
+        return self.youngs_modulus * self.inertia
+
+    @property
+    def axial_rigidity(self) -> float:
+        """EA [N]."""
+        return self.youngs_modulus * self.area
+
+    @property
+    def mass_per_length(self) -> float:
+        """ρA [kg/m]."""
+        return self.rho * self.area
+
+    @property
+    def element_length(self) -> float:
+        return self.length / self.elements
+
+    @property
+    def nodes(self):
+        import numpy as np
+
+        return np.linspace(0.0, self.length, self.elements + 1)
+
+    @property
+    def dofs_per_node(self) -> int:
+        return 2 if self.kind == "beam" else 1
+
+    @property
+    def n_dof(self) -> int:
+        return self.dofs_per_node * (self.elements + 1)
+
+    def effects_named(self, name: str) -> list[Effect]:
+        return [e for e in self.effects if e.name == name]
+
+    def with_effects(self, effects) -> "Model":
+        """A copy with ``effects`` (an iterable of :class:`Effect`) replacing the present ones."""
+        effects = tuple(effects)
+        for e in effects:
+            validate_effect(self, e.name, dict(e.parameters), self.source or "model")
+        return replace(self, effects=effects)
+
+    def with_elements(self, elements: int) -> "Model":
+        return replace(self, elements=int(elements))
+
+
+# -------------------------------------------------------------------------------------------
+# Loading and validation
+# -------------------------------------------------------------------------------------------
+
+
+def load_model(path) -> Model:
+    """Read and validate a model TOML file; raises :class:`GfeInputError` on bad input."""
+    path = Path(path)
+    where = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise GfeInputError(where, None, f"cannot read model file ({exc.strerror})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise GfeInputError(where, None, f"not valid TOML ({exc})") from None
+    return model_from_dict(data, where)
+
+
+def model_from_dict(data: dict, where: str = "model") -> Model:
+    """Build a :class:`Model` from the parsed TOML mapping (same validation as files)."""
+    _no_unknown(data, {"name", "kind", "length", "elements", "material", "section",
+                       "supports", "effects", "mass"}, where, "")
+    kind = _choice(data, "kind", ("beam", "bar"), where)
+    length = _number(data, "length", where, positive=True)
+    elements = data.get("elements")
+    if elements is None:
+        raise GfeInputError(where, "elements", "missing (number of elements, an integer >= 1)")
+    if isinstance(elements, bool) or not isinstance(elements, int) or elements < 1:
+        raise GfeInputError(where, "elements", f"must be an integer >= 1, got {elements!r}")
+    name = data.get("name", Path(where).stem)
+    if not isinstance(name, str):
+        raise GfeInputError(where, "name", f"must be a string, got {name!r}")
+
+    material = _table(data, "material", where)
+    _no_unknown(material, {"E", "rho", "nu"}, where, "material.")
+    E = _number(material, "E", where, positive=True, prefix="material.")
+    rho = _number(material, "rho", where, positive=True, prefix="material.")
+    nu = _number(material, "nu", where, prefix="material.", default=0.3)
+    if not -1.0 < nu < 0.5:
+        raise GfeInputError(where, "material.nu", f"Poisson's ratio must lie in (-1, 0.5), got {nu}")
+
+    section = _table(data, "section", where)
+    depth = breadth = None
+    shape = section.get("shape")
+    if shape is not None:
+        if shape != "rectangle":
+            raise GfeInputError(where, "section.shape",
+                                f"unknown shape {shape!r} (known: 'rectangle', or give A and I)")
+        _no_unknown(section, {"shape", "b", "h"}, where, "section.")
+        breadth = _number(section, "b", where, positive=True, prefix="section.")
+        depth = _number(section, "h", where, positive=True, prefix="section.")
+        area, inertia = breadth * depth, breadth * depth**3 / 12.0
+    else:
+        _no_unknown(section, {"A", "I", "h"}, where, "section.")
+        area = _number(section, "A", where, positive=True, prefix="section.")
+        need_i = kind == "beam"
+        inertia = _number(section, "I", where, positive=True, prefix="section.",
+                          default=None if need_i else 0.0)
+        if "h" in section:
+            depth = _number(section, "h", where, positive=True, prefix="section.")
+
+    supports_tbl = _table(data, "supports", where)
+    _no_unknown(supports_tbl, {"left", "right"}, where, "supports.")
+    allowed = BEAM_SUPPORTS if kind == "beam" else BAR_SUPPORTS
+    supports = tuple(_choice(supports_tbl, side, allowed, where, prefix="supports.")
+                     for side in ("left", "right"))
+
+    mass_models = BEAM_MASS_MODELS if kind == "beam" else BAR_MASS_MODELS
+    mass_model = data.get("mass", "consistent")
+    if mass_model not in mass_models:
+        raise GfeInputError(where, "mass", f"unknown mass model {mass_model!r} "
+                            f"(known for a {kind}: {', '.join(mass_models)})")
+
+    model = Model(name=name, kind=kind, length=length, elements=elements, E=E, rho=rho, nu=nu,
+                  area=area, inertia=inertia, supports=supports, depth=depth, breadth=breadth,
+                  mass_model=mass_model, source=where)
+
+    effects_raw = data.get("effects", [])
+    if not isinstance(effects_raw, list):
+        raise GfeInputError(where, "effects", "must be an array of tables ([[effects]])")
+    effects = []
+    for i, raw in enumerate(effects_raw):
+        if not isinstance(raw, dict):
+            raise GfeInputError(where, f"effects[{i}]", "must be a table")
+        raw = dict(raw)
+        name_ = raw.pop("effect", None)
+        if name_ is None:
+            raise GfeInputError(where, f"effects[{i}].effect", "missing (the effect's name)")
+        effects.append(Effect(name_, validate_effect(model, name_, raw, where, f"effects[{i}].")))
+    return replace(model, effects=tuple(effects))
+
+
+def validate_effect(model: Model, name: str, params: dict, where: str, prefix: str = "") -> dict:
+    """Check an effect's name and parameters against :data:`EFFECT_PARAMETERS`; return them."""
+    if name not in EFFECT_PARAMETERS:
+        raise GfeInputError(where, f"{prefix}effect",
+                            f"unknown effect {name!r} (known: {', '.join(EFFECT_PARAMETERS)})")
+    if model.kind != "beam" and name in BEAM_ONLY_EFFECTS:
+        raise GfeInputError(where, f"{prefix}effect", f"effect {name!r} needs kind = \"beam\"")
+    spec = EFFECT_PARAMETERS[name]
+    _no_unknown(params, set(spec), where, prefix)
+    out = {}
+    for key, (unit, rule) in spec.items():
+        if key not in params:
+            raise GfeInputError(where, f"{prefix}{key}", f"missing ({name} needs {key} [{unit}])")
+        value = params[key]
+        if rule == "side":
+            if value not in SPRING_SIDES:
+                raise GfeInputError(where, f"{prefix}{key}",
+                                    f"must be one of {', '.join(SPRING_SIDES)}, got {value!r}")
+            out[key] = value
+            continue
+        value = _as_float(value, where, f"{prefix}{key}")
+        if rule == "positive" and value <= 0:
+            raise GfeInputError(where, f"{prefix}{key}", f"must be > 0 [{unit}], got {value:g}")
+        if rule == "fraction" and not 0.0 < value < 1.0:
+            raise GfeInputError(where, f"{prefix}{key}", f"must lie in (0, 1), got {value:g}")
+        if rule == "position" and not 0.0 <= value <= model.length:
+            raise GfeInputError(where, f"{prefix}{key}",
+                                f"{value:g} m lies outside the structure [0, {model.length:g}] m")
+        out[key] = value
+    if name == "crack" and model.depth is None:
+        raise GfeInputError(where, f"{prefix}effect",
+                            "a crack needs the section depth (section.h or shape = 'rectangle')")
+    return out
+
+
+def _as_float(value, where, fieldname):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise GfeInputError(where, fieldname, f"must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise GfeInputError(where, fieldname, f"must be finite, got {value}")
+    return value
+
+
+def _number(tbl, key, where, positive=False, prefix="", default=None):
+    if key not in tbl:
+        if default is not None:
+            return default
+        raise GfeInputError(where, prefix + key, "missing")
+    value = _as_float(tbl[key], where, prefix + key)
+    if positive and value <= 0:
+        raise GfeInputError(where, prefix + key, f"must be > 0, got {value:g}")
+    return value
+
+
+def _choice(tbl, key, allowed, where, prefix=""):
+    if key not in tbl:
+        raise GfeInputError(where, prefix + key, f"missing (one of {', '.join(allowed)})")
+    value = tbl[key]
+    if value not in allowed:
+        raise GfeInputError(where, prefix + key,
+                            f"unknown value {value!r} (one of {', '.join(allowed)})")
+    return value
+
+
+def _table(data, key, where):
+    tbl = data.get(key)
+    if tbl is None:
+        raise GfeInputError(where, key, f"missing [{key}] table")
+    if not isinstance(tbl, dict):
+        raise GfeInputError(where, key, "must be a table")
+    return tbl
+
+
+def _no_unknown(tbl, known, where, prefix):
+    import difflib
+
+    for key in tbl:
+        if key not in known:
+            close = difflib.get_close_matches(key, sorted(known), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise GfeInputError(where, prefix + key, f"unknown key{hint}")
