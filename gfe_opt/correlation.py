@@ -1,0 +1,240 @@
+r"""Test–model correlation: MAC, pairing, frequency errors, COMAC and the modal residual force.
+
+Residual force and expansion (documented contract of :func:`expand_modes`)
+---------------------------------------------------------------------------
+For a measured mode with circular frequency :math:`ω` and shape :math:`y` at the sensors
+(:math:`C` maps model DOFs to sensors), the model's dynamic stiffness is
+:math:`D = K - ω^2 M` (free DOFs).  We look for forces :math:`λ` *acting only at the
+sensors* that make the model vibrate at :math:`ω` in the measured shape:
+
+.. math:: D φ = C^T λ, \qquad C φ \approx y .
+
+With :math:`G = C D^{-1} C^T` (the model's receptance between sensors at :math:`ω`),
+:math:`λ` is the Tikhonov solution :math:`\min_λ \|Gλ - y\|^2 + α^2\|λ\|^2`, with α chosen
+by the discrepancy principle :math:`\|Gλ - y\| = δ\|y\|` for the stated shape noise δ.
+For noise-free data at the model nodes this is Kidder's dynamic expansion: unmeasured DOFs
+(rotations, translations between sensors) satisfy their rows of :math:`Dφ = 0` exactly.
+The expanded shape is :math:`φ = D^{-1}C^Tλ` and the residual force :math:`(K-ω^2M)φ`
+equals :math:`C^Tλ`: it vanishes where the model is right and concentrates where it fails.
+Per sensor i and mode j we report :math:`r_{ij} = |λ_{ij}| / \|ω_j^2 M φ_j\|`
+(residual relative to the mode's inertia force) and combine modes as
+:math:`r_i = (\sum_j r_{ij}^2)^{1/2}`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.optimize import linear_sum_assignment
+
+from .assembly import Discretisation, discretise
+from .errors import GfeSolverError
+from .measured import MeasuredModes, sensor_matrix
+from .modal import Modes, discretisation_modes
+from .model import Model
+
+DEFAULT_MAC_THRESHOLD = 0.6
+DEFAULT_SHAPE_NOISE = 0.01
+
+
+def mac(a, b) -> np.ndarray:
+    r"""Modal assurance criterion :math:`|a_i^H b_j|^2 / (|a_i|^2 |b_j|^2)`, shape (n_a, n_b).
+
+    ``a`` (n, n_a) and ``b`` (n, n_b) hold shapes as columns on the same DOFs.
+    """
+    a = np.asarray(a)
+    b = np.asarray(b)
+    num = np.abs(a.conj().T @ b) ** 2
+    den = np.outer(np.einsum("ij,ij->j", a.conj(), a).real, np.einsum("ij,ij->j", b.conj(), b).real)
+    return num / den
+
+
+def pair_modes(mac_matrix, threshold: float = DEFAULT_MAC_THRESHOLD) -> list[tuple[int, int]]:
+    """Pair test modes (rows) with model modes (columns) by MAC, not by index.
+
+    A one-to-one assignment maximising the total MAC (Hungarian algorithm); pairs whose MAC
+    is below ``threshold`` are dropped, so a test mode the model lacks stays unpaired.
+    """
+    rows, cols = linear_sum_assignment(-np.asarray(mac_matrix))
+    keep = mac_matrix[rows, cols] >= threshold
+    return sorted(zip(rows[keep].tolist(), cols[keep].tolist()))
+
+
+def comac(test, model) -> np.ndarray:
+    r"""Coordinate MAC per sensor for paired shapes ``test`` and ``model`` (n_sensors, n_pairs).
+
+    Each pair is first brought to unit norm and a common sign;
+    :math:`\mathrm{COMAC}_i = (\sum_j |t_{ij} m_{ij}|)^2 / (\sum_j t_{ij}^2 \sum_j m_{ij}^2)`.
+    """
+    t = test / np.linalg.norm(test, axis=0)
+    m = model / np.linalg.norm(model, axis=0)
+    m = m * np.sign(np.sum(t * m, axis=0))
+    num = np.sum(np.abs(t * m), axis=1) ** 2
+    den = np.sum(t**2, axis=1) * np.sum(m**2, axis=1)
+    return np.divide(num, den, out=np.ones_like(num), where=den > 0)
+
+
+@dataclass(frozen=True)
+class Expansion:
+    """Expanded shapes (n_dof, n_modes) and residual forces at sensors (n_sensors, n_modes)."""
+
+    shapes: np.ndarray
+    forces: np.ndarray
+    relative_residual: np.ndarray
+
+
+def expand_modes(disc: Discretisation, C, omega, shapes, noise: float = DEFAULT_SHAPE_NOISE,
+                 K=None, M=None) -> Expansion:
+    """Regularised dynamic expansion of measured shapes (see module docstring)."""
+    if K is None or M is None:
+        K, M = disc.global_matrices()
+    free = disc.free
+    Kf = sp.csc_matrix(K)[free][:, free]
+    Mf = sp.csc_matrix(M)[free][:, free]
+    Cf = sp.csr_matrix(C)[:, free]
+    n_dof = K.shape[0]
+    out_shapes = np.zeros((n_dof, len(omega)))
+    forces = np.zeros((C.shape[0], len(omega)))
+    rel = np.zeros_like(forces)
+    for j, w in enumerate(omega):
+        D = (Kf - w**2 * Mf).tocsc()
+        try:
+            lu = spla.splu(D)
+        except RuntimeError:  # ω is exactly a model eigenvalue: nudge it
+            lu = spla.splu((Kf - (w * (1 + 1e-9)) ** 2 * Mf).tocsc())
+        X = lu.solve(Cf.T.toarray())  # D^-1 C^T, (n_free, n_sensors)
+        G = Cf @ X
+        G = 0.5 * (G + G.T)
+        y = shapes[:, j]
+        lam = _tikhonov_discrepancy(G, y, noise)
+        phi = X @ lam
+        out_shapes[free, j] = phi
+        inertia = np.linalg.norm(w**2 * (Mf @ phi))
+        forces[:, j] = lam
+        rel[:, j] = np.abs(lam) / inertia if inertia > 0 else np.inf
+    return Expansion(out_shapes, forces, rel)
+
+
+def _tikhonov_discrepancy(G, y, noise):
+    """min ||G λ - y||² + α²||λ||² with α chosen so that ||G λ - y|| = noise ||y||."""
+    u, s, vt = np.linalg.svd(G)
+    beta = u.T @ y
+    target = noise * np.linalg.norm(y)
+
+    def misfit(alpha):
+        return np.linalg.norm(alpha**2 / (s**2 + alpha**2) * beta)
+
+    lo, hi = s[-1] * 1e-6 + 1e-300, s[0] * 1e3
+    if noise <= 0 or misfit(lo) >= target:
+        alpha = lo
+    else:
+        for _ in range(200):
+            mid = np.sqrt(lo * hi)
+            lo, hi = (mid, hi) if misfit(mid) < target else (lo, mid)
+            if hi / lo < 1 + 1e-6:
+                break
+        alpha = np.sqrt(lo * hi)
+    return vt.T @ (s / (s**2 + alpha**2) * beta)
+
+
+@dataclass(frozen=True)
+class Pair:
+    test_mode: int
+    model_mode: int
+    test_hz: float
+    model_hz: float
+    error_pct: float
+    mac: float
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Result of :func:`compare` (modes numbered from 1 in ``pairs``)."""
+
+    pairs: list
+    mac_matrix: np.ndarray
+    unpaired_test_modes: list
+    sensor_x: np.ndarray
+    comac: np.ndarray
+    residual: np.ndarray
+    residual_per_mode: np.ndarray
+    model_modes: Modes
+    expanded_shapes: np.ndarray
+    notes: list = field(default_factory=list)
+
+    @property
+    def freq_error_rms_pct(self) -> float:
+        err = np.array([p.error_pct for p in self.pairs])
+        return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
+
+    @property
+    def mac_mean(self) -> float:
+        return float(np.mean([p.mac for p in self.pairs])) if self.pairs else float("nan")
+
+    def localisation(self) -> list[dict]:
+        return [{"x": float(x), "residual": float(r)} for x, r in zip(self.sensor_x,
+                                                                        self.residual)]
+
+    def failure_places(self, fraction: float = 0.6, at_most: int = 3) -> list[tuple[float, float]]:
+        """Local maxima of the residual above ``fraction`` of the largest, largest first."""
+        r = self.residual
+        padded = np.concatenate([[-np.inf], r, [-np.inf]])
+        peaks = np.flatnonzero((r >= padded[:-2]) & (r >= padded[2:]) & (r >= fraction * r.max()))
+        peaks = peaks[np.argsort(-r[peaks])][:at_most]
+        return [(float(self.sensor_x[i]), float(r[i] / r.max())) for i in peaks]
+
+    def to_json(self) -> dict:
+        """The ``compare --json`` contract."""
+        return {
+            "pairs": [{"test_mode": p.test_mode, "model_mode": p.model_mode,
+                       "test_hz": p.test_hz, "model_hz": p.model_hz,
+                       "error_pct": p.error_pct, "mac": p.mac} for p in self.pairs],
+            "freq_error_rms_pct": self.freq_error_rms_pct,
+            "mac_mean": self.mac_mean,
+            "localisation": self.localisation(),
+        }
+
+
+def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_THRESHOLD,
+            noise=DEFAULT_SHAPE_NOISE, n_model_modes: int | None = None,
+            disc: Discretisation | None = None) -> Comparison:
+    """Compare a model with measured modes: pairs, frequency errors, MAC, COMAC, residual.
+
+    ``noise`` is the relative shape noise δ used to regularise the expansion.
+    """
+    disc = discretise(model) if disc is None else disc
+    C = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
+    n_free = len(disc.free)
+    n_model = n_model_modes or min(max(2 * measured.n_modes, measured.n_modes + 4), n_free - 2)
+    modes = discretisation_modes(disc, n_model)
+    at_sensors = C @ modes.shapes
+    mac_matrix = mac(measured.shapes, at_sensors)
+    pairs_idx = pair_modes(mac_matrix, mac_threshold)
+    pairs = [Pair(test_mode=t + 1, model_mode=m + 1,
+                  test_hz=float(measured.frequencies_hz[t]),
+                  model_hz=float(modes.frequencies_hz[m]),
+                  error_pct=float(100.0 * (modes.frequencies_hz[m] - measured.frequencies_hz[t])
+                                  / measured.frequencies_hz[t]),
+                  mac=float(mac_matrix[t, m])) for t, m in pairs_idx]
+    unpaired = sorted(set(range(measured.n_modes)) - {t for t, _ in pairs_idx})
+    notes = []
+    if unpaired:
+        notes.append(f"test mode(s) {[u + 1 for u in unpaired]} have no model mode with "
+                     f"MAC >= {mac_threshold}")
+    if not pairs_idx:
+        raise GfeSolverError("no test mode pairs with any model mode "
+                             f"(MAC >= {mac_threshold}); check sensors and units")
+    t_idx = [t for t, _ in pairs_idx]
+    m_idx = [m for _, m in pairs_idx]
+    K, M = disc.global_matrices()
+    expansion = expand_modes(disc, C, measured.omega[t_idx], measured.shapes[:, t_idx],
+                             noise, K, M)
+    residual = np.sqrt(np.sum(expansion.relative_residual**2, axis=1))
+    return Comparison(pairs=pairs, mac_matrix=mac_matrix, unpaired_test_modes=unpaired,
+                      sensor_x=measured.x, comac=comac(measured.shapes[:, t_idx],
+                                                       at_sensors[:, m_idx]),
+                      residual=residual, residual_per_mode=expansion.relative_residual,
+                      model_modes=modes, expanded_shapes=expansion.shapes, notes=notes)

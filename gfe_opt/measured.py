@@ -1,0 +1,355 @@
+"""Measured modes: frequencies [Hz] and shapes at sensors, read from JSON, CSV or UFF.
+
+Formats (contracts, see README "Measured modes"):
+
+* JSON::
+
+    {"sensors": {"x": [0.0125, 0.025], "dof": "w"},
+     "modes": [{"frequency": 223.4, "shape": [0.068, 0.136]}]}
+
+* CSV: a header row ``x,<f1>,<f2>,...`` (the first cell any label, the others the natural
+  frequencies in Hz), then one row per sensor: its position x [m] and one value per mode.
+  Lines starting with ``#`` are comments.  The DOF is the model's (``w`` beam, ``u`` bar).
+* UFF (``.uff``/``.unv``): node coordinates from dataset 15 or 2411 (x along the structure),
+  one dataset 55 (analysis type 2, normal modes) per mode.  ``w`` is read from the z
+  component (or y when every z is zero), ``u`` from the x component.
+
+Shapes may have any scale and sign.  Modes are sorted by frequency; sensors keep file order.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import elements as el
+from .errors import GfeInputError
+
+DOFS = ("w", "u")
+
+
+@dataclass(frozen=True)
+class MeasuredModes:
+    """Measured natural frequencies (n_modes,) [Hz] and shapes (n_sensors, n_modes).
+
+    ``x`` holds the sensor positions [m] from the left end, ``dof`` the measured direction
+    (``"w"`` transverse, ``"u"`` axial).
+    """
+
+    x: np.ndarray
+    dof: str
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    source: str = "measured"
+
+    @property
+    def n_modes(self) -> int:
+        return len(self.frequencies_hz)
+
+    @property
+    def n_sensors(self) -> int:
+        return len(self.x)
+
+    @property
+    def omega(self) -> np.ndarray:
+        return 2.0 * np.pi * self.frequencies_hz
+
+
+def make_measured(x, dof, frequencies_hz, shapes, source="measured") -> MeasuredModes:
+    """Validate and build :class:`MeasuredModes` (modes sorted by frequency)."""
+    if dof not in DOFS:
+        raise GfeInputError(source, "sensors.dof", f"unknown dof {dof!r} (one of w, u)")
+    x = _finite_array(x, source, "sensors.x", ndim=1)
+    if x.size == 0:
+        raise GfeInputError(source, "sensors.x", "no sensors")
+    if np.unique(x).size != x.size:
+        dup = x[np.flatnonzero(np.diff(np.sort(x)) == 0)[0]]
+        raise GfeInputError(source, "sensors.x", f"sensor position {dup:g} m appears twice")
+    f = _finite_array(frequencies_hz, source, "frequency", ndim=1)
+    if f.size == 0:
+        raise GfeInputError(source, "modes", "no modes")
+    if np.any(f <= 0):
+        i = int(np.flatnonzero(f <= 0)[0])
+        raise GfeInputError(source, f"modes[{i}].frequency", f"must be > 0 Hz, got {f[i]:g}")
+    shapes = _finite_array(shapes, source, "shape", ndim=2)
+    if shapes.shape != (x.size, f.size):
+        raise GfeInputError(source, "shape", f"expected {x.size} values per mode (one per "
+                            f"sensor) for {f.size} modes, got array {shapes.shape}")
+    zero = np.flatnonzero(~np.any(shapes != 0, axis=0))
+    if zero.size:
+        raise GfeInputError(source, f"modes[{zero[0]}].shape", "all values are zero")
+    order = np.argsort(f, kind="stable")
+    f, shapes = f[order], shapes[:, order]
+    dup = np.flatnonzero(np.diff(f) == 0)
+    if dup.size:
+        raise GfeInputError(source, "frequency", f"frequency {f[dup[0]]:g} Hz appears twice")
+    return MeasuredModes(x=x, dof=dof, frequencies_hz=f, shapes=shapes, source=source)
+
+
+def _finite_array(values, source, field, ndim):
+    try:
+        arr = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise GfeInputError(source, field, "must hold numbers only") from None
+    if arr.ndim != ndim:
+        raise GfeInputError(source, field, f"must be a {ndim}-d array of numbers")
+    if not np.all(np.isfinite(arr)):
+        raise GfeInputError(source, field, "contains NaN or infinite values")
+    return arr
+
+
+# -------------------------------------------------------------------------------------------
+# Readers
+# -------------------------------------------------------------------------------------------
+
+
+def load_measured(path, dof: str | None = None) -> MeasuredModes:
+    """Read measured modes from ``.json``, ``.csv`` or ``.uff``/``.unv``.
+
+    ``dof`` is needed only where the file does not say it (CSV; defaults to ``"w"``).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise GfeInputError(str(path), None, "no such file")
+    suffix = path.suffix.lower()
+    if suffix == ".json":
+        return _read_json(path)
+    if suffix == ".csv":
+        return _read_csv(path, dof or "w")
+    if suffix in (".uff", ".unv"):
+        return _read_uff(path, dof)
+    raise GfeInputError(str(path), None, f"unknown measured-data format {suffix!r} "
+                        "(use .json, .csv, .uff or .unv)")
+
+
+def _read_json(path: Path) -> MeasuredModes:
+    where = str(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise GfeInputError(where, None, f"cannot read ({exc})") from None
+    except json.JSONDecodeError as exc:
+        raise GfeInputError(where, None, f"not valid JSON ({exc})") from None
+    if not isinstance(data, dict):
+        raise GfeInputError(where, None, "top level must be an object with sensors and modes")
+    for key in data:
+        if key not in ("sensors", "modes"):
+            raise GfeInputError(where, key, "unknown key (expected sensors, modes)")
+    sensors = data.get("sensors")
+    if not isinstance(sensors, dict) or "x" not in sensors:
+        raise GfeInputError(where, "sensors", "missing or without x (sensor positions in m)")
+    for key in sensors:
+        if key not in ("x", "dof"):
+            raise GfeInputError(where, f"sensors.{key}", "unknown key (expected x, dof)")
+    modes = data.get("modes")
+    if not isinstance(modes, list) or not modes:
+        raise GfeInputError(where, "modes", "missing or empty (a list of modes)")
+    freqs, shapes = [], []
+    n_sensors = len(sensors["x"]) if isinstance(sensors["x"], list) else -1
+    for i, mode in enumerate(modes):
+        if not isinstance(mode, dict) or "frequency" not in mode or "shape" not in mode:
+            raise GfeInputError(where, f"modes[{i}]", "needs frequency and shape")
+        for key in mode:
+            if key not in ("frequency", "shape"):
+                raise GfeInputError(where, f"modes[{i}].{key}", "unknown key")
+        if not _is_number(mode["frequency"]):
+            raise GfeInputError(where, f"modes[{i}].frequency",
+                                f"must be a number, got {mode['frequency']!r}")
+        if not isinstance(mode["shape"], list) or not all(_is_number(v) for v in mode["shape"]):
+            raise GfeInputError(where, f"modes[{i}].shape", "must be a list of numbers")
+        if len(mode["shape"]) != n_sensors:
+            raise GfeInputError(where, f"modes[{i}].shape", f"has {len(mode['shape'])} values "
+                                f"but there are {n_sensors} sensors")
+        freqs.append(mode["frequency"])
+        shapes.append(mode["shape"])
+    return make_measured(sensors["x"], sensors.get("dof", "w"), freqs,
+                         np.array(shapes, dtype=float).T, where)
+
+
+def _is_number(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _read_csv(path: Path, dof: str) -> MeasuredModes:
+    where = str(path)
+    try:
+        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines()
+                 if ln.strip() and not ln.lstrip().startswith("#")]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise GfeInputError(where, None, f"cannot read ({exc})") from None
+    rows = list(csv.reader(lines))
+    if len(rows) < 2:
+        raise GfeInputError(where, None, "needs a header row of frequencies and sensor rows")
+    header = rows[0]
+    try:
+        freqs = [float(v) for v in header[1:]]
+    except ValueError:
+        raise GfeInputError(where, "header", "cells after the first must be frequencies in "
+                            f"Hz, got {header[1:]}") from None
+    x, shapes = [], []
+    for i, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise GfeInputError(where, f"row {i}", f"has {len(row)} cells, header has "
+                                f"{len(header)}")
+        try:
+            vals = [float(v) for v in row]
+        except ValueError:
+            raise GfeInputError(where, f"row {i}", f"non-numeric cell in {row}") from None
+        x.append(vals[0])
+        shapes.append(vals[1:])
+    return make_measured(x, dof, freqs, np.array(shapes), where)
+
+
+def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
+    import pyuff
+
+    where = str(path)
+    try:
+        sets = pyuff.UFF(str(path)).read_sets()
+    except Exception as exc:  # pyuff raises bare Exceptions on malformed files
+        raise GfeInputError(where, None, f"not a readable UFF file ({exc})") from None
+    if isinstance(sets, dict):
+        sets = [sets]
+    coords = {}
+    modes = []
+    for s in sets:
+        if s.get("type") in (15, 2411):
+            for n, x in zip(np.asarray(s["node_nums"]).astype(int), s["x"]):
+                coords[int(n)] = float(x)
+        elif s.get("type") == 55 and s.get("analysis_type") == 2:
+            modes.append(s)
+    if not coords:
+        raise GfeInputError(where, "dataset 15/2411", "no node coordinates found")
+    if not modes:
+        raise GfeInputError(where, "dataset 55", "no normal-mode data (analysis type 2) found")
+    nodes = [int(n) for n in np.asarray(modes[0]["node_nums"]).astype(int)]
+    missing = [n for n in nodes if n not in coords]
+    if missing:
+        raise GfeInputError(where, "dataset 55", f"node {missing[0]} has no coordinates")
+    if dof is None:
+        has_z = any(np.any(np.asarray(m["r3"]) != 0) for m in modes)
+        has_y = any(np.any(np.asarray(m["r2"]) != 0) for m in modes)
+        dof, comp = ("w", "r3") if has_z else (("w", "r2") if has_y else ("u", "r1"))
+    else:
+        comp = "r1" if dof == "u" else "r3"
+    shapes, freqs = [], []
+    for i, m in enumerate(modes):
+        if [int(n) for n in np.asarray(m["node_nums"]).astype(int)] != nodes:
+            raise GfeInputError(where, f"dataset 55 #{i + 1}", "nodes differ from the first mode")
+        shapes.append(np.real(np.asarray(m[comp], dtype=complex)))
+        freqs.append(float(m["freq"]))
+    return make_measured([coords[n] for n in nodes], dof, freqs, np.array(shapes).T, where)
+
+
+# -------------------------------------------------------------------------------------------
+# Writers (atomic: a crash leaves the old file or the new one)
+# -------------------------------------------------------------------------------------------
+
+
+def atomic_write(path, write) -> None:
+    """Call ``write(tmp_path)`` and move the result onto ``path`` in one step."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def measured_to_dict(m: MeasuredModes) -> dict:
+    """The JSON form of measured modes."""
+    return {"sensors": {"x": [float(v) for v in m.x], "dof": m.dof},
+            "modes": [{"frequency": float(f), "shape": [float(v) for v in m.shapes[:, j]]}
+                      for j, f in enumerate(m.frequencies_hz)]}
+
+
+def save_measured(m: MeasuredModes, path) -> None:
+    """Write measured modes as ``.json``, ``.csv`` or ``.uff``/``.unv`` (by extension)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".json":
+        text = json.dumps(measured_to_dict(m), indent=1)
+        atomic_write(path, lambda p: p.write_text(text + "\n", encoding="utf-8"))
+    elif suffix == ".csv":
+        def write(p):
+            with open(p, "w", newline="", encoding="utf-8") as fh:
+                w = csv.writer(fh)
+                w.writerow(["x"] + [repr(float(f)) for f in m.frequencies_hz])
+                for i, x in enumerate(m.x):
+                    w.writerow([repr(float(x))] + [repr(float(v)) for v in m.shapes[i]])
+        atomic_write(path, write)
+    elif suffix in (".uff", ".unv"):
+        atomic_write(path, lambda p: _write_uff(m, p))
+    else:
+        raise GfeInputError(str(path), None, f"unknown measured-data format {suffix!r}")
+
+
+def _write_uff(m: MeasuredModes, path) -> None:
+    import pyuff
+
+    n = m.n_sensors
+    nodes = np.arange(1, n + 1)
+    zeros = np.zeros(n)
+    sets = [pyuff.prepare_2411(node_nums=nodes, def_cs=np.zeros(n, int),
+                               disp_cs=np.zeros(n, int), color=np.ones(n, int),
+                               x=np.asarray(m.x, float), y=zeros, z=zeros,
+                               return_full_dict=True)]
+    for j, f in enumerate(m.frequencies_hz):
+        comp = {"r1": zeros, "r2": zeros, "r3": zeros}
+        comp["r1" if m.dof == "u" else "r3"] = m.shapes[:, j].astype(float)
+        sets.append(pyuff.prepare_55(
+            id1=f"gfe-opt mode {j + 1}", id2="NONE", id3="NONE", id4="NONE", id5="NONE",
+            model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, data_type=2,
+            n_data_per_node=3, load_case=1, mode_n=j + 1, freq=float(f), modal_m=0.0,
+            modal_damp_vis=0.0, modal_damp_his=0.0, node_nums=nodes, return_full_dict=True,
+            **comp))
+    pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")
+
+
+# -------------------------------------------------------------------------------------------
+# Mapping sensors onto a model
+# -------------------------------------------------------------------------------------------
+
+
+def sensor_matrix(nodes, kind: str, x, dof: str, source="measured") -> sp.csr_matrix:
+    """Observation matrix C (n_sensors, n_dof): model response at the sensors = C φ.
+
+    A sensor between nodes is interpolated with the element shape functions (cubic Hermite
+    for a beam's w, linear for a bar's u); a sensor outside the structure is an error.
+    """
+    nodes = np.asarray(nodes, float)
+    length = nodes[-1] - nodes[0]
+    expected = "w" if kind == "beam" else "u"
+    if dof != expected:
+        raise GfeInputError(source, "sensors.dof",
+                            f"measured dof {dof!r} does not fit a {kind} model (needs {expected!r})")
+    x = np.asarray(x, float)
+    tol = 1e-9 * length
+    outside = np.flatnonzero((x < nodes[0] - tol) | (x > nodes[-1] + tol))
+    if outside.size:
+        i = int(outside[0])
+        raise GfeInputError(source, f"sensors.x[{i}]", f"{x[i]:g} m lies outside the "
+                            f"structure [{nodes[0]:g}, {nodes[-1]:g}] m")
+    n_el = len(nodes) - 1
+    L = length / n_el
+    e = np.clip(np.floor((x - nodes[0]) / L).astype(int), 0, n_el - 1)
+    xi = np.clip((x - nodes[e]) / L, 0.0, 1.0)
+    if kind == "beam":
+        vals = el.hermite(xi) * np.array([1.0, L, 1.0, L])
+        cols = 2 * e[:, None] + np.arange(4)
+        n_dof = 2 * (n_el + 1)
+    else:
+        vals = el.linear(xi)
+        cols = e[:, None] + np.arange(2)
+        n_dof = n_el + 1
+    rows = np.repeat(np.arange(x.size), vals.shape[1])
+    return sp.csr_matrix((vals.ravel(), (rows, cols.ravel())), shape=(x.size, n_dof))
+
