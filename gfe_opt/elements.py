@@ -131,6 +131,11 @@ def symmetric_beam_mass(m11, m12, m14, m22):
     return affine_matrix(SYMMETRIC_BEAM_MASS_CONSTANT, SYMMETRIC_BEAM_MASS_BASIS, params)
 
 
+#: eq. 11 as :math:`H^T P H`: relative deformations ``d = H u`` of the scaled element DOFs
+#: (deflection and rotation of node i relative to node j) and P = [[k_ww, k_wt], [k_wt, k_tt]].
+BEAM_DEFORMATION_H = np.array([[1.0, 0.0, -1.0, 1.0], [0.0, 1.0, 0.0, -1.0]])
+
+
 def beam_dof_scaling(L):
     """Diagonal of T with ``[w, Lθ, w, Lθ] = T [w, θ, w, θ]``; physical K = T K_scaled T."""
     L = np.asarray(L, dtype=float)
@@ -222,10 +227,14 @@ BAR_MASS_BETA = {"lumped": 0.0, "consistent": 1.0 / 6.0, "harmonic": 1.0 / 8.0,
 #: Euler–Bernoulli consistent mass (cubic Hermite shape functions).  The paper prints
 #: m14 = 13/420; the entry of the consistent matrix in position (1, 4) is −13/420.
 CONSISTENT_BEAM_MASS = {"m11": 13 / 35, "m12": 11 / 210, "m14": -13 / 420, "m22": 1 / 105}
-#: Stavrinidis et al. higher-order mass (6th-order eigenvalue error).
-HIGHER_ORDER_BEAM_MASS = {"m11": 163 / 420, "m12": 51 / 840, "m14": -19 / 840, "m22": 15 / 840}
-#: Lumped translational mass (no rotary inertia); positive semidefinite only.
-LUMPED_BEAM_MASS = {"m11": 0.5, "m12": 0.0, "m14": 0.0, "m22": 0.0}
+#: The "higher-order" mass as the paper prints it (after Stavrinidis et al.).  Measured here
+#: (tests/test_modal.py): its eigenvalue error is -(kh)^4/360, 4th order, not 6th.
+PAPER_HIGHER_ORDER_BEAM_MASS = {"m11": 163 / 420, "m12": 51 / 840, "m14": -19 / 840,
+                                "m22": 15 / 840}
+#: A 6th-order mass of the eq. 17 family: (2 x consistent + printed higher-order) / 3, the
+#: combination whose (kh)^4 error terms (+1/720 and -1/360) cancel.  Used as "higher_order".
+HIGHER_ORDER_BEAM_MASS = {k: (2 * CONSISTENT_BEAM_MASS[k] + PAPER_HIGHER_ORDER_BEAM_MASS[k]) / 3
+                          for k in CONSISTENT_BEAM_MASS}
 
 
 def euler_bernoulli_stiffness(EI):

@@ -35,7 +35,7 @@ from .errors import GfeInputError
 
 BEAM_SUPPORTS = ("pinned", "clamped", "free", "sliding")
 BAR_SUPPORTS = ("fixed", "free")
-BEAM_MASS_MODELS = ("consistent", "higher_order", "lumped")
+BEAM_MASS_MODELS = ("consistent", "higher_order")
 BAR_MASS_MODELS = ("consistent", "lumped", "harmonic", "minimum_error")
 
 #: Effect names and their parameter keys (a contract shared with model files and the CLI).

@@ -1,0 +1,123 @@
+"""Modal analysis against closed forms, and observed convergence rates."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from gfe_opt import elements as el
+from gfe_opt.assembly import discretise
+from gfe_opt.modal import discretisation_modes, model_modes
+from gfe_opt.model import Effect
+
+from .conftest import STEEL_BAR, make_model
+
+
+def _roots(f, count):
+    """First ``count`` positive roots of f, bracketed on a fine grid."""
+    grid = np.linspace(0.1, 4 * count + 4, 4000)
+    vals = f(grid)
+    idx = np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[:count]
+    return np.array([brentq(f, grid[i], grid[i + 1]) for i in idx])
+
+
+def _beam_omega(model, beta_l):
+    return beta_l**2 / model.length**2 * np.sqrt(model.bending_rigidity / model.mass_per_length)
+
+
+def test_simply_supported_beam(beam):
+    f = model_modes(beam, 5).frequencies_hz
+    exact = _beam_omega(beam, np.arange(1, 6) * np.pi) / (2 * np.pi)
+    assert np.allclose(f, exact, rtol=2e-5)
+
+
+def test_clamped_free_beam():
+    m = make_model(supports={"left": "clamped", "right": "free"})
+    roots = _roots(lambda x: np.cos(x) * np.cosh(x) + 1, 4)
+    assert np.isclose(roots[0], 1.8751, atol=1e-4)
+    f = model_modes(m, 4).frequencies_hz
+    assert np.allclose(f, _beam_omega(m, roots) / (2 * np.pi), rtol=2e-5)
+
+
+def test_free_free_beam_has_two_rigid_modes():
+    m = make_model(supports={"left": "free", "right": "free"})
+    modes = model_modes(m, 5)
+    f = modes.frequencies_hz
+    assert np.all(np.abs(f[:2]) < 1e-8 * f[2])
+    roots = _roots(lambda x: np.cos(x) * np.cosh(x) - 1, 3)
+    assert np.allclose(f[2:], _beam_omega(m, roots) / (2 * np.pi), rtol=2e-5)
+
+
+def test_fixed_free_bar():
+    bar = make_model(STEEL_BAR, elements=200)
+    f = model_modes(bar, 4).frequencies_hz
+    n = np.arange(1, 5)
+    exact = (2 * n - 1) * np.pi / (2 * bar.length) * np.sqrt(bar.E / bar.rho) / (2 * np.pi)
+    assert np.allclose(f, exact, rtol=2e-4)
+
+
+def _slope(h, err):
+    return np.polyfit(np.log(h), np.log(np.abs(err)), 1)[0]
+
+
+@pytest.mark.parametrize("mass,order", [("lumped", 2), ("consistent", 2),
+                                        ("minimum_error", 4)])
+def test_bar_convergence_rate(mass, order):
+    meshes = np.array([8, 16, 32, 64])
+    base = make_model(STEEL_BAR, mass=mass)
+    exact = 3 * np.pi / (2 * base.length) * np.sqrt(base.E / base.rho) / (2 * np.pi)
+    err = [model_modes(base.with_elements(n), 2).frequencies_hz[1] / exact - 1 for n in meshes]
+    assert abs(_slope(1.0 / meshes, err) - order) < 0.25
+
+
+def _beam_mode2_errors(meshes, mass_params):
+    base = make_model()
+    k = 2 * np.pi / base.length
+    exact = k**4 * base.bending_rigidity / base.mass_per_length
+    out = []
+    for n in meshes:
+        disc = discretise(base.with_elements(n))
+        t = el.beam_dof_scaling(disc.element_length)
+        scaled = el.symmetric_beam_mass(**{k_: np.full(n, v) for k_, v in mass_params.items()})
+        mass = base.mass_per_length * disc.element_length * scaled * (t[:, None] * t[None, :])
+        modes = discretisation_modes(replace(disc, mass=mass), 3)
+        out.append((2 * np.pi * modes.frequencies_hz[1]) ** 2 / exact - 1)
+    return np.array(out), k
+
+
+@pytest.mark.parametrize("name,order,leading", [
+    ("CONSISTENT_BEAM_MASS", 4, 1 / 720),          # +(kh)^4/720 (REFERENCES, computed)
+    ("PAPER_HIGHER_ORDER_BEAM_MASS", 4, -1 / 360),  # the paper's printed numbers: 4th order
+    ("HIGHER_ORDER_BEAM_MASS", 6, None),            # (2 consistent + printed) / 3
+])
+def test_beam_eigenvalue_convergence_rate(name, order, leading):
+    meshes = np.array([6, 8, 12, 16])
+    err, k = _beam_mode2_errors(meshes, getattr(el, name))
+    assert abs(_slope(1.0 / meshes, err) - order) < 0.3
+    if leading is not None:
+        h = make_model().length / meshes[-1]
+        assert np.isclose(err[-1], leading * (k * h) ** 4, rtol=0.05)
+
+
+def test_higher_order_mass_model_key_selects_sixth_order_mass():
+    plain, better = make_model(elements=8), make_model(elements=8, mass="higher_order")
+    exact = (np.pi / plain.length) ** 2 * np.sqrt(plain.bending_rigidity / plain.mass_per_length)
+    f = [model_modes(m, 1).frequencies_hz[0] * 2 * np.pi / exact - 1 for m in (plain, better)]
+    assert abs(f[1]) < abs(f[0]) / 50
+
+
+def test_cracked_beam_frequency_ratios_match_reference():
+    # REFERENCES: a/d = 2/3 at mid-span (d half-depth) lowers mode 1 to 0.757, mode 3 to 0.8321
+    plain = make_model()
+    cracked = plain.with_effects([Effect("crack", {"position": 0.2875, "depth_ratio": 2 / 3})])
+    ratio = model_modes(cracked, 3).frequencies_hz / model_modes(plain, 3).frequencies_hz
+    assert np.allclose(ratio, [0.757, 0.9985, 0.8321], atol=6e-4)
+
+
+def test_fine_mesh_keeps_accuracy():
+    # raw shift-invert eigenvalues lose ~eps N^4 (1e-3 at N = 3000); see modal.py
+    m = make_model(elements=10000)
+    f = model_modes(m, 5).frequencies_hz
+    exact = _beam_omega(m, np.arange(1, 6) * np.pi) / (2 * np.pi)
+    assert np.allclose(f, exact, rtol=1e-6)
