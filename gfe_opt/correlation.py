@@ -66,13 +66,14 @@ def pair_modes(mac_matrix, threshold: float = DEFAULT_MAC_THRESHOLD) -> list[tup
 def comac(test, model) -> np.ndarray:
     r"""Coordinate MAC per sensor for paired shapes ``test`` and ``model`` (n_sensors, n_pairs).
 
-    Each pair is first brought to unit norm and a common sign;
-    :math:`\mathrm{COMAC}_i = (\sum_j |t_{ij} m_{ij}|)^2 / (\sum_j t_{ij}^2 \sum_j m_{ij}^2)`.
+    Each pair is first brought to unit norm and a common sign; then
+    :math:`\mathrm{COMAC}_i = (\sum_j t_{ij} m_{ij})^2 / (\sum_j t_{ij}^2 \sum_j m_{ij}^2)`
+    (the signed form, which also sees a sensor whose sign disagrees).
     """
     t = test / np.linalg.norm(test, axis=0)
     m = model / np.linalg.norm(model, axis=0)
     m = m * np.sign(np.sum(t * m, axis=0))
-    num = np.sum(np.abs(t * m), axis=1) ** 2
+    num = np.sum(t * m, axis=1) ** 2
     den = np.sum(t**2, axis=1) * np.sum(m**2, axis=1)
     return np.divide(num, den, out=np.ones_like(num), where=den > 0)
 

@@ -309,7 +309,7 @@ def _write_uff(m: MeasuredModes, path) -> None:
             id1=f"gfe-opt mode {j + 1}", id2="NONE", id3="NONE", id4="NONE", id5="NONE",
             model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, data_type=2,
             n_data_per_node=3, load_case=1, mode_n=j + 1, freq=float(f), modal_m=0.0,
-            modal_damp_vis=0.0, modal_damp_his=0.0, node_nums=nodes, return_full_dict=True,
+            modal_damp_vis=0.0, modal_damp_his=0.0, node_nums=nodes,
             **comp))
     pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")
 
