@@ -1,1 +1,18 @@
-"""gfe-opt: finite-element model updating with generic elements and physical realisation."""
+"""gfe-opt: finite-element model updating with generic elements and physical realisation.
+
+The stages are separate calls with plain data between them::
+
+    model = load_model("beam.toml")
+    measured = load_measured("test.json")
+    result = compare(model, measured)
+"""
+
+from .correlation import Comparison, compare, mac
+from .errors import GfeInputError, GfeSolverError
+from .measured import MeasuredModes, load_measured, save_measured
+from .modal import Modes, model_modes
+from .model import Effect, Model, load_model
+
+__all__ = ["Comparison", "Effect", "GfeInputError", "GfeSolverError", "MeasuredModes", "Model",
+           "Modes", "compare", "load_measured", "load_model", "mac", "model_modes",
+           "save_measured"]

@@ -232,12 +232,11 @@ def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
     missing = [n for n in nodes if n not in coords]
     if missing:
         raise GfeInputError(where, "dataset 55", f"node {missing[0]} has no coordinates")
+    has_z = any(np.any(np.asarray(m["r3"]) != 0) for m in modes)
+    has_y = any(np.any(np.asarray(m["r2"]) != 0) for m in modes)
     if dof is None:
-        has_z = any(np.any(np.asarray(m["r3"]) != 0) for m in modes)
-        has_y = any(np.any(np.asarray(m["r2"]) != 0) for m in modes)
-        dof, comp = ("w", "r3") if has_z else (("w", "r2") if has_y else ("u", "r1"))
-    else:
-        comp = "r1" if dof == "u" else "r3"
+        dof = "w" if has_z or has_y else "u"
+    comp = "r1" if dof == "u" else ("r3" if has_z or not has_y else "r2")
     shapes, freqs = [], []
     for i, m in enumerate(modes):
         if [int(n) for n in np.asarray(m["node_nums"]).astype(int)] != nodes:
@@ -329,8 +328,8 @@ def sensor_matrix(nodes, kind: str, x, dof: str, source="measured") -> sp.csr_ma
     length = nodes[-1] - nodes[0]
     expected = "w" if kind == "beam" else "u"
     if dof != expected:
-        raise GfeInputError(source, "sensors.dof",
-                            f"measured dof {dof!r} does not fit a {kind} model (needs {expected!r})")
+        raise GfeInputError(source, "sensors.dof", f"measured dof {dof!r} does not fit a "
+                            f"{kind} model (needs {expected!r})")
     x = np.asarray(x, float)
     tol = 1e-9 * length
     outside = np.flatnonzero((x < nodes[0] - tol) | (x > nodes[-1] + tol))

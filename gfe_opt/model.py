@@ -191,7 +191,8 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
     rho = _number(material, "rho", where, positive=True, prefix="material.")
     nu = _number(material, "nu", where, prefix="material.", default=0.3)
     if not -1.0 < nu < 0.5:
-        raise GfeInputError(where, "material.nu", f"Poisson's ratio must lie in (-1, 0.5), got {nu}")
+        raise GfeInputError(where, "material.nu",
+                            f"Poisson's ratio must lie in (-1, 0.5), got {nu}")
 
     section = _table(data, "section", where)
     depth = breadth = None

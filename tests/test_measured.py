@@ -73,9 +73,10 @@ def test_uff_with_dataset_15_nodes(tmp_path):
                              mode_n=1, freq=12.5, modal_m=0.0, modal_damp_vis=0.0,
                              modal_damp_his=0.0, node_nums=np.arange(1, n + 1))]
     pyuff.UFF(str(tmp_path / "t.unv")).write_sets(sets, mode="overwrite")
-    m = load_measured(tmp_path / "t.unv")
-    assert m.dof == "w" and np.allclose(m.x, x) and np.allclose(m.shapes[:, 0], np.sin(x),
-                                                                  atol=1e-5)
+    for dof in (None, "w"):  # w read from y when every z is zero
+        m = load_measured(tmp_path / "t.unv", dof=dof)
+        assert m.dof == "w" and np.allclose(m.x, x)
+        assert np.allclose(m.shapes[:, 0], np.sin(x), atol=1e-5)
 
 
 @pytest.mark.parametrize("change,match", [

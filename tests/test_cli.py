@@ -1,0 +1,74 @@
+"""The gfe-opt command: compare table and JSON contract, exit codes, the demo."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from gfe_opt.cli import main
+from gfe_opt.demo import problem_file
+from gfe_opt.measured import save_measured
+from gfe_opt.model import Effect, load_model
+from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("cli")
+    model_path = problem_file("ss-steel-beam.toml")
+    model = load_model(model_path)
+    truth = model.with_effects([Effect("crack", {"position": 0.4, "depth_ratio": 0.5})])
+    measured = synthetic_measurement(truth, 4, interior_sensors(model.length, 30),
+                                     shape_noise=0.003, seed=3)
+    save_measured(measured, tmp / "measured.json")
+    return model_path, tmp / "measured.json", tmp
+
+
+def test_compare_table(files, capsys):
+    model, measured, _ = files
+    assert main(["compare", str(model), str(measured)]) == 0
+    out = capsys.readouterr().out
+    assert "f_test [Hz]" in out and "MAC" in out
+    assert len([ln for ln in out.splitlines() if ln.strip()[:1].isdigit()]) >= 4
+    assert "the model fails most near x = 0.4" in out
+
+
+def test_compare_json_contract(files, capsys):
+    model, measured, _ = files
+    assert main(["compare", str(model), str(measured), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert set(data) == {"pairs", "freq_error_rms_pct", "mac_mean", "localisation"}
+    assert set(data["pairs"][0]) == {"test_mode", "model_mode", "test_hz", "model_hz",
+                                     "error_pct", "mac"}
+    assert len(data["pairs"]) == 4 and data["freq_error_rms_pct"] > 1.0
+    assert set(data["localisation"][0]) == {"x", "residual"} and len(data["localisation"]) == 30
+
+
+def test_bad_input_exits_2_with_one_line_and_no_traceback(files, tmp_path):
+    model, _, _ = files
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"sensors": {"x": [0.1, 0.9]}, "modes": [{"frequency": 1, "shape": [1, 2]}]}')
+    run = subprocess.run([sys.executable, "-m", "gfe_opt.cli", "compare", str(model), str(bad)],
+                         capture_output=True, text=True)
+    assert run.returncode == 2
+    assert "Traceback" not in run.stderr
+    assert run.stderr.strip().count("\n") == 0
+    assert "sensors.x[1]: 0.9 m lies outside" in run.stderr
+
+
+def test_missing_file_exits_2(files, capsys):
+    model, _, tmp = files
+    assert main(["compare", str(model), str(tmp / "none.json")]) == 2
+    assert "no such file" in capsys.readouterr().err
+
+
+def test_demo_runs_and_refuses_to_overwrite(tmp_path, capsys):
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert (out / "model.toml").exists() and (out / "measured.json").exists()
+    assert "the model fails most near x = 0.1" in text
+    assert main(["demo", "--out", str(out)]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert main(["demo", "--out", str(out), "--force"]) == 0
