@@ -164,29 +164,37 @@ def slope_gram(L: float) -> np.ndarray:
     return el.timoshenko_rotary_inertia(1.0, L, 0.0)
 
 
-def _beam_stiffness_params(model: Model, L: float) -> dict:
-    n = model.elements
-    EI = model.bending_rigidity
+def cracked_element_stiffness(model: Model, element_stiffness) -> dict:
+    """Generic parameters of every element of a cracked beam.
+
+    EI(x) = EI Π_c Q_c(x) (Christides–Barr, eq. 25); ``element_stiffness`` is
+    :func:`~gfe_opt.elements.beam_stiffness_from_flexibility` (the models) or
+    :func:`~gfe_opt.elements.beam_stiffness_from_rigidity` (independent references).
+    """
     cracks = model.effects_named("crack")
-    if cracks:
-        half_depth = model.depth / 2.0
-        decay = half_depth / (2.0 * el.SHEN_PIERRE_GAMMA)
+    EI, L = model.bending_rigidity, model.element_length
+    half_depth = model.depth / 2.0
 
-        def rigidity(x):
-            q = np.ones_like(x)
-            for c in cracks:
-                q = q * el.christides_barr_q(x, c.parameters["position"],
-                                             c.parameters["depth_ratio"], half_depth)
-            return EI * q
+    def rigidity(x):
+        q = np.ones_like(x)
+        for c in cracks:
+            q = q * el.christides_barr_q(x, c.parameters["position"],
+                                         c.parameters["depth_ratio"], half_depth)
+        return EI * q
 
-        positions = [c.parameters["position"] for c in cracks]
-        params = np.array([
-            el.beam_stiffness_from_flexibility(rigidity, e * L, L, positions, decay)
-            for e in range(n)
-        ])
-        out = {"k_ww": params[:, 0], "k_wt": params[:, 1], "k_tt": params[:, 2]}
+    positions = [c.parameters["position"] for c in cracks]
+    decay = half_depth / (2.0 * el.SHEN_PIERRE_GAMMA)
+    k = np.array([element_stiffness(rigidity, e * L, L, positions, decay)
+                  for e in range(model.elements)])
+    return {"k_ww": k[:, 0], "k_wt": k[:, 1], "k_tt": k[:, 2]}
+
+
+def _beam_stiffness_params(model: Model, L: float) -> dict:
+    if model.effects_named("crack"):
+        out = cracked_element_stiffness(model, el.beam_stiffness_from_flexibility)
     else:
-        out = {k: np.full(n, v) for k, v in el.euler_bernoulli_stiffness(EI).items()}
+        out = {k: np.full(model.elements, v)
+               for k, v in el.euler_bernoulli_stiffness(model.bending_rigidity).items()}
     shear = model.effects_named("shear")
     if shear:
         g = el.shear_parameter(out["k_ww"] / 12.0, shear[0].parameters["shear_rigidity"], L)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import elements as el
-from .assembly import discretise
+from .assembly import cracked_element_stiffness, discretise
 from .measured import MeasuredModes, make_measured, sensor_matrix
 from .modal import discretisation_modes
 from .model import Model
@@ -22,28 +22,12 @@ from .model import Model
 def reference_discretisation(truth: Model, elements: int):
     """Fine-mesh discretisation of ``truth``, cracks integrated with Hermite curvatures."""
     fine = truth.with_elements(elements)
-    disc = discretise(fine)
-    cracks = fine.effects_named("crack")
-    if not cracks:
-        return disc
-    L = fine.element_length
-    half_depth = fine.depth / 2.0
-    EI = fine.bending_rigidity
-
-    def rigidity(x):
-        q = np.ones_like(x)
-        for c in cracks:
-            q = q * el.christides_barr_q(x, c.parameters["position"],
-                                         c.parameters["depth_ratio"], half_depth)
-        return EI * q
-
-    positions = [c.parameters["position"] for c in cracks]
-    k = np.array([el.beam_stiffness_from_rigidity(rigidity, e * L, L, positions,
-                                                  half_depth / (2 * el.SHEN_PIERRE_GAMMA))
-                  for e in range(fine.elements)])
-    params = {"k_ww": k[:, 0], "k_wt": k[:, 1], "k_tt": k[:, 2]}
+    if not fine.effects_named("crack"):
+        return discretise(fine)
+    disc = discretise(fine.with_effects(e for e in fine.effects if e.name != "crack"))
     if fine.effects_named("shear"):
         raise NotImplementedError("reference with both crack and shear is not provided")
+    params = cracked_element_stiffness(fine, el.beam_stiffness_from_rigidity)
     return disc.with_stiffness(params)
 
 

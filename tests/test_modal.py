@@ -121,3 +121,47 @@ def test_fine_mesh_keeps_accuracy():
     f = model_modes(m, 5).frequencies_hz
     exact = _beam_omega(m, np.arange(1, 6) * np.pi) / (2 * np.pi)
     assert np.allclose(f, exact, rtol=1e-6)
+
+
+def _ss_exact(model, n, extra_stiffness=0.0, tension=0.0):
+    a = n * np.pi / model.length
+    return np.sqrt((model.bending_rigidity * a**4 + tension * a**2 + extra_stiffness)
+                   / model.mass_per_length) / (2 * np.pi)
+
+
+def test_axial_tension_closed_form():
+    m = make_model(elements=60)
+    t = 2.0e4
+    f = model_modes(m.with_effects([Effect("axial_load", {"tension": t})]), 3).frequencies_hz
+    assert np.allclose(f, _ss_exact(m, np.arange(1, 4), tension=t), rtol=1e-5)
+
+
+def test_winkler_foundation_closed_form():
+    m = make_model(elements=60)
+    k = 5.0e6
+    f = model_modes(m.with_effects([Effect("foundation", {"stiffness": k})]), 3).frequencies_hz
+    assert np.allclose(f, _ss_exact(m, np.arange(1, 4), extra_stiffness=k), rtol=1e-5)
+
+
+@pytest.mark.parametrize("h_over_l,ratio", [(0.05, 0.99580), (0.10, 0.98357), (0.20, 0.93966)])
+def test_timoshenko_ratio_matches_reference(h_over_l, ratio):
+    # REFERENCES: rectangle, kappa = 5/6, nu = 0.3; shear and rotary inertia
+    length = 1.0
+    h = h_over_l * length
+    m = make_model(length=length, elements=200, section={"b": 0.01, "h": h})
+    g_mod = m.E / (2 * (1 + m.nu))
+    shear = Effect("shear", {"shear_rigidity": 5 / 6 * g_mod * m.area})
+    f = model_modes(m.with_effects([shear]), 1).frequencies_hz[0]
+    assert np.isclose(f / _ss_exact(m, 1), ratio, atol=2e-5)
+
+
+def test_point_mass_and_support_spring_bounds():
+    m = make_model(elements=40)
+    f0 = model_modes(m, 2).frequencies_hz
+    heavy = m.with_effects([Effect("point_mass", {"position": m.length / 2, "mass": 0.5})])
+    f = model_modes(heavy, 2).frequencies_hz
+    assert f[0] < f0[0] and np.isclose(f[1], f0[1], rtol=1e-6)  # mode 2 has a node at mid-span
+    stiff = m.with_effects([Effect("support_spring", {"stiffness": 1e12, "side": "both"})])
+    clamped = make_model(elements=40, supports={"left": "clamped", "right": "clamped"})
+    assert np.allclose(model_modes(stiff, 2).frequencies_hz,
+                       model_modes(clamped, 2).frequencies_hz, rtol=1e-5)
