@@ -1,0 +1,102 @@
+r"""Parameterisations of a beam's generic stiffness: small vectors q -> (k_ww, k_wt, k_tt).
+
+Each parameterisation is linear, :math:`p = A q` with ``p`` the stacked element parameters
+``[k_ww (N), k_wt (N), k_tt (N)]`` and ``A`` sparse, so an equation error stays affine in q.
+
+* ``element``: every element's own (k_ww, k_wt, k_tt), 3N parameters (eq. 11);
+* ``nodal``: nodal bending stiffness k_i and slope ∂k_i/∂x, 2N+2 parameters (eq. 13);
+* ``linear``: k_i only, k varying linearly in each element (eq. 23), N+1 parameters;
+* ``constant``: one k per element, k_ww = 12k, k_wt = 6k, k_tt = 4k, N parameters.
+
+Eq. 13 is derived here (:func:`derive_nodal_coefficients`) as the exact integral
+:math:`\int_0^1 EI(ξ) N''N''^T dξ` of a cubic-Hermite interpolated EI(x) with nodal values
+k_i, k_{i+1} and slopes k'_i L, k'_{i+1} L.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import scipy.sparse as sp
+import sympy
+from scipy.sparse.linalg import lsqr
+
+PARAMETERISATIONS = ("element", "nodal", "linear", "constant")
+
+
+@lru_cache(maxsize=1)
+def derive_nodal_coefficients() -> sympy.Matrix:
+    """Eq. 13 by exact integration: rows k_ww, k_wt, k_tt; columns k_i, k'_i L, k_{i+1},
+    k'_{i+1} L (sympy Rationals)."""
+    xi = sympy.Symbol("xi")
+    hermite = [1 - 3 * xi**2 + 2 * xi**3, xi - 2 * xi**2 + xi**3, 3 * xi**2 - 2 * xi**3,
+               -(xi**2) + xi**3]
+    curv = [sympy.diff(h, xi, 2) for h in hermite]
+    rows = []
+    for a, b in ((0, 0), (0, 1), (1, 1)):  # K[0,0] = k_ww, K[0,1] = k_wt, K[1,1] = k_tt
+        rows.append([sympy.integrate(h * curv[a] * curv[b], (xi, 0, 1)) for h in hermite])
+    return sympy.Matrix(rows)
+
+
+@dataclass(frozen=True)
+class Parameterisation:
+    """A linear map q -> stacked element parameters ``[k_ww, k_wt, k_tt]`` (3N,)."""
+
+    name: str
+    matrix: sp.csr_matrix  # (3N, n_q)
+    labels: tuple[str, ...]
+
+    @property
+    def n_params(self) -> int:
+        return self.matrix.shape[1]
+
+    def element_parameters(self, q) -> dict:
+        p = self.matrix @ np.asarray(q, float)
+        n = self.matrix.shape[0] // 3
+        return {"k_ww": p[:n], "k_wt": p[n:2 * n], "k_tt": p[2 * n:]}
+
+    def fit(self, params: dict) -> np.ndarray:
+        """The q whose element parameters are closest (least squares) to ``params``."""
+        target = np.concatenate([params["k_ww"], params["k_wt"], params["k_tt"]])
+        return lsqr(self.matrix, target, atol=1e-14, btol=1e-14)[0]
+
+
+def beam_parameterisation(name: str, n_elements: int, element_length: float) -> Parameterisation:
+    """Build one of :data:`PARAMETERISATIONS` for N equal elements of length L."""
+    n, L = n_elements, element_length
+    e = np.arange(n)
+    if name == "element":
+        return Parameterisation(name, sp.identity(3 * n, format="csr"),
+                                tuple(f"{k}[{i}]" for k in ("k_ww", "k_wt", "k_tt")
+                                      for i in range(n)))
+    if name == "nodal":
+        c = np.array(derive_nodal_coefficients(), dtype=float)  # (3, 4)
+        # q = [k_0..k_N, k'_0..k'_N]; element columns k_i, k'_i L, k_{i+1}, k'_{i+1} L
+        cols = np.stack([e, n + 1 + e, e + 1, n + 1 + e + 1], axis=1)
+        scale = np.array([1.0, L, 1.0, L])
+        rows, cs, vals = [], [], []
+        for r in range(3):
+            rows.append(np.repeat(r * n + e, 4))
+            cs.append(cols.ravel())
+            vals.append(np.tile(c[r] * scale, n))
+        A = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cs))),
+                          shape=(3 * n, 2 * (n + 1)))
+        labels = tuple(f"k[{i}]" for i in range(n + 1)) + tuple(
+            f"dk/dx[{i}]" for i in range(n + 1))
+        return Parameterisation(name, A, labels)
+    if name == "linear":  # eq. 23: k_ww = 6k_i + 6k_j, k_wt = 4k_i + 2k_j, k_tt = 3k_i + k_j
+        coef = np.array([[6.0, 6.0], [4.0, 2.0], [3.0, 1.0]])
+        rows = np.concatenate([np.repeat(r * n + e, 2) for r in range(3)])
+        cols = np.tile(np.stack([e, e + 1], 1).ravel(), 3)
+        vals = np.concatenate([np.tile(coef[r], n) for r in range(3)])
+        return Parameterisation(name, sp.csr_matrix((vals, (rows, cols)), shape=(3 * n, n + 1)),
+                                tuple(f"k[{i}]" for i in range(n + 1)))
+    if name == "constant":
+        rows = np.concatenate([r * n + e for r in range(3)])
+        vals = np.repeat([12.0, 6.0, 4.0], n)
+        return Parameterisation(name, sp.csr_matrix((vals, (rows, np.tile(e, 3))),
+                                                    shape=(3 * n, n)),
+                                tuple(f"k[{i}]" for i in range(n)))
+    raise ValueError(f"unknown parameterisation {name!r} (one of {', '.join(PARAMETERISATIONS)})")
