@@ -66,13 +66,17 @@ def format_comparison(result: Comparison, length: float) -> str:
         lines.append(f"{t + 1:>4}  (no model mode with MAC >= threshold)")
     lines.append(f"frequency error (rms) {result.freq_error_rms_pct:.2f} %, "
                  f"mean MAC {result.mac_mean:.3f}")
+    places = result.failure_places()
+    lines.append("")
+    if not places:
+        lines.append("no residual force: the model reproduces the measured shapes")
+        lines.extend(f"note: {n}" for n in result.notes)
+        return "\n".join(lines)
     r = result.residual / result.residual.max()
     spark = "".join(SPARK[int(round(v * (len(SPARK) - 1)))] for v in r)
-    lines.append("")
     lines.append("residual force along the structure (left end -> right end):")
     lines.append(f"  |{spark}|")
-    places = result.failure_places()
-    x0, rel0 = places[0]
+    x0, _ = places[0]
     lines.append(f"the model fails most near x = {x0:.3f} m ({100 * x0 / length:.0f} % of the "
                  "length)")
     for x, rel in places[1:]:

@@ -182,6 +182,8 @@ class Comparison:
     def failure_places(self, fraction: float = 0.6, at_most: int = 3) -> list[tuple[float, float]]:
         """Local maxima of the residual above ``fraction`` of the largest, largest first."""
         r = self.residual
+        if not np.any(r > 0):
+            return []
         padded = np.concatenate([[-np.inf], r, [-np.inf]])
         peaks = np.flatnonzero((r >= padded[:-2]) & (r >= padded[2:]) & (r >= fraction * r.max()))
         peaks = peaks[np.argsort(-r[peaks])][:at_most]

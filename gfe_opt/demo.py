@@ -46,8 +46,9 @@ def run_demo(out: Path, force: bool = False) -> int:
     print("3. Compare the model with the test and see where it fails:\n")
     result = compare(model, measured)
     print("   " + format_comparison(result, model.length).replace("\n", "\n   "))
-    x = result.failure_places()[0][0]
-    print(f"\n   The hidden crack is at x = {DEMO_CRACK['position']} m; the residual force "
-          f"points to x = {x:.3f} m.")
+    places = result.failure_places()
+    if places:
+        print(f"\n   The hidden crack is at x = {DEMO_CRACK['position']} m; the residual force "
+              f"points to x = {places[0][0]:.3f} m.")
     print(f"\nReproduce step 3 with:\n  gfe-opt compare {model_path} {measured_path}")
     return 0

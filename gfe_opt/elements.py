@@ -205,8 +205,7 @@ class Violation:
 def feasibility_violations(conditions, params, margin: float = 0.0) -> list[Violation]:
     """Conditions of ``conditions`` that ``params`` (scalars or per-element arrays) violate.
 
-    A condition holds when its value exceeds ``margin`` times the scale of the parameters it
-    involves (``margin = 0``: strict inequality).
+    A condition holds when its value exceeds ``margin`` (``margin = 0``: strict inequality).
     """
     out = []
     for cond in conditions:

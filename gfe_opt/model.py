@@ -25,11 +25,14 @@ The file form is a contract (see README, "Model file")::
 
 from __future__ import annotations
 
+import difflib
 import math
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from .errors import GfeInputError
 
@@ -123,9 +126,7 @@ class Model:
         return self.length / self.elements
 
     @property
-    def nodes(self):
-        import numpy as np
-
+    def nodes(self) -> np.ndarray:
         return np.linspace(0.0, self.length, self.elements + 1)
 
     @property
@@ -320,8 +321,6 @@ def _table(data, key, where):
 
 
 def _no_unknown(tbl, known, where, prefix):
-    import difflib
-
     for key in tbl:
         if key not in known:
             close = difflib.get_close_matches(key, sorted(known), n=1)
