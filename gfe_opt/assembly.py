@@ -198,10 +198,7 @@ def _beam_stiffness_params(model: Model, L: float) -> dict:
     shear = model.effects_named("shear")
     if shear:
         g = el.shear_parameter(out["k_ww"] / 12.0, shear[0].parameters["shear_rigidity"], L)
-        # Timoshenko correction of eq. 18 applied to the (possibly varying) bending element.
-        k_ww = out["k_ww"] / (1.0 + g)
-        k_tt = out["k_tt"] * (4.0 + g) / (4.0 * (1.0 + g))
-        out = {"k_ww": k_ww, "k_wt": k_ww / 2.0, "k_tt": k_tt}
+        out = el.timoshenko_correction(out, g)
     return out
 
 

@@ -212,7 +212,8 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
     C = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
     n_free = len(disc.free)
     n_model = n_model_modes or min(max(2 * measured.n_modes, measured.n_modes + 4), n_free - 2)
-    modes = discretisation_modes(disc, n_model)
+    K, M = disc.global_matrices()
+    modes = discretisation_modes(disc, n_model, matrices=(K, M))
     at_sensors = C @ modes.shapes
     mac_matrix = mac(measured.shapes, at_sensors)
     pairs_idx = pair_modes(mac_matrix, mac_threshold)
@@ -232,7 +233,6 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
                              f"(MAC >= {mac_threshold}); check sensors and units")
     t_idx = [t for t, _ in pairs_idx]
     m_idx = [m for _, m in pairs_idx]
-    K, M = disc.global_matrices()
     expansion = expand_modes(disc, C, measured.omega[t_idx], measured.shapes[:, t_idx],
                              noise, K, M)
     residual = np.sqrt(np.sum(expansion.relative_residual**2, axis=1))

@@ -254,8 +254,7 @@ def timoshenko_parameters(EI, shear_rigidity, L):
     """
     g = shear_parameter(EI, shear_rigidity, L)
     d = (1.0 + g) ** 2
-    k_ww = 12.0 * EI / (1.0 + g)
-    stiffness = {"k_ww": k_ww, "k_wt": k_ww / 2.0, "k_tt": EI * (4.0 + g) / (1.0 + g)}
+    stiffness = timoshenko_correction(euler_bernoulli_stiffness(EI), g)
     mass = {
         "m11": (13 / 35 + 7 / 10 * g + g**2 / 3) / d,
         "m12": (11 / 210 + 11 / 120 * g + g**2 / 24) / d,
@@ -263,6 +262,17 @@ def timoshenko_parameters(EI, shear_rigidity, L):
         "m22": (1 / 105 + g / 60 + g**2 / 120) / d,
     }
     return stiffness, mass
+
+
+def timoshenko_correction(bending, g):
+    """eq. 18 applied to bending parameters: k_ww / (1 + g), k_tt (4 + g) / (4 (1 + g)).
+
+    For Euler–Bernoulli ``bending`` (12EI, 6EI, 4EI) this is eq. 18 exactly; for a varying
+    EI it is the same shear softening per element.  ``k_wt = k_ww / 2`` (symmetric element).
+    """
+    k_ww = bending["k_ww"] / (1.0 + g)
+    return {"k_ww": k_ww, "k_wt": k_ww / 2.0,
+            "k_tt": bending["k_tt"] * (4.0 + g) / (4.0 * (1.0 + g))}
 
 
 def timoshenko_rotary_inertia(rho_I, L, g=0.0):

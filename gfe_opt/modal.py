@@ -89,15 +89,16 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=shapes)
 
 
-def discretisation_modes(disc: Discretisation, n_modes: int, params=None) -> Modes:
+def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
+                         matrices=None) -> Modes:
     """Modes of a discretisation, optionally with replaced generic stiffness parameters.
 
     Eigenvalues are the Rayleigh quotients of the computed (mass-normalised) shapes with the
     strain energy summed element by element (:meth:`Discretisation.strain_energy`): the
     shift-invert eigenvalues lose about eps N⁴ relative accuracy on an N-element beam, the
-    shapes and this quotient do not.
+    shapes and this quotient do not.  ``matrices`` may pass (K, M) already assembled.
     """
-    K, M = disc.global_matrices(params)
+    K, M = disc.global_matrices(params) if matrices is None else matrices
     modes = solve_modes(K, M, n_modes, disc.constrained, disc.eigenvalue_scale)
     lam = np.maximum(disc.strain_energy(modes.shapes, params), 0.0)
     lam = np.where(modes.frequencies_hz == 0.0, 0.0, lam)
