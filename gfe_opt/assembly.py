@@ -74,28 +74,29 @@ class Discretisation:
         ks = el.generic_beam_stiffness(params["k_ww"], params["k_wt"], params["k_tt"])
         return ks * (t[:, None] * t[None, :]) / L**3
 
-    def strain_energy(self, shapes, params=None) -> np.ndarray:
-        r"""Twice the strain energy :math:`φ^T K φ` of each column of ``shapes`` (n_dof, n).
+    def element_strain_energy(self, shapes, params=None) -> np.ndarray:
+        r"""Twice the generic strain energy :math:`φ_e^T K_e φ_e` per element, (n_elements, n).
 
-        The generic part is summed element by element from relative deformations
-        (eq. 11 = :math:`H^T P H`, bar: :math:`u_i - u_j`), which keeps full precision on fine
-        meshes where forming :math:`K φ` cancels catastrophically (error ~ eps N⁴).
+        Summed from relative deformations (eq. 11 = :math:`H^T P H`, bar: :math:`u_i - u_j`),
+        which keeps full precision on fine meshes where forming :math:`K φ` cancels
+        catastrophically (error ~ eps N⁴).
         """
         params = self.stiffness_params if params is None else params
         L = self.element_length
         u = shapes[self.element_dofs()]  # (n_elements, 2n, n_modes)
         if self.kind == "bar":
-            energy = np.einsum("e,em->m", params["k"] / L, (u[:, 0] - u[:, 1]) ** 2)
-        else:
-            u = u * el.beam_dof_scaling(L)[:, None]
-            d = np.einsum("ij,ejm->eim", el.BEAM_DEFORMATION_H, u)
-            energy = np.einsum("e,em->m", params["k_ww"], d[:, 0] ** 2) + np.einsum(
-                "e,em->m", 2 * params["k_wt"], d[:, 0] * d[:, 1]) + np.einsum(
-                "e,em->m", params["k_tt"], d[:, 1] ** 2)
-            energy = energy / L**3
-        energy = energy + np.einsum("eim,eij,ejm->m", u if self.kind == "bar" else
-                                    shapes[self.element_dofs()], self.extra_stiffness,
-                                    shapes[self.element_dofs()])
+            return (params["k"] / L)[:, None] * (u[:, 0] - u[:, 1]) ** 2
+        u = u * el.beam_dof_scaling(L)[:, None]
+        d = np.einsum("ij,ejm->eim", el.BEAM_DEFORMATION_H, u)
+        return (params["k_ww"][:, None] * d[:, 0] ** 2
+                + 2 * params["k_wt"][:, None] * d[:, 0] * d[:, 1]
+                + params["k_tt"][:, None] * d[:, 1] ** 2) / L**3
+
+    def strain_energy(self, shapes, params=None) -> np.ndarray:
+        """Twice the total strain energy :math:`φ^T K φ` of each column of ``shapes``."""
+        u = shapes[self.element_dofs()]
+        energy = self.element_strain_energy(shapes, params).sum(axis=0)
+        energy = energy + np.einsum("eim,eij,ejm->m", u, self.extra_stiffness, u)
         for dof, value in self.nodal_stiffness:
             energy = energy + value * shapes[dof] ** 2
         return energy

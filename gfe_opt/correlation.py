@@ -11,7 +11,8 @@ sensors* that make the model vibrate at :math:`ω` in the measured shape:
 
 With :math:`G = C D^{-1} C^T` (the model's receptance between sensors at :math:`ω`),
 :math:`λ` is the Tikhonov solution :math:`\min_λ \|Gλ - y\|^2 + α^2\|λ\|^2`, with α chosen
-by the discrepancy principle :math:`\|Gλ - y\| = δ\|y\|` for the stated shape noise δ.
+by the discrepancy principle :math:`\|Gλ - y\| = δ \max|y| \sqrt{n_s}` for the stated
+shape noise δ (standard deviation relative to the mode's largest amplitude).
 For noise-free data at the model nodes this is Kidder's dynamic expansion: unmeasured DOFs
 (rotations, translations between sensors) satisfy their rows of :math:`Dφ = 0` exactly.
 The expanded shape is :math:`φ = D^{-1}C^Tλ` and the residual force :math:`(K-ω^2M)φ`
@@ -120,10 +121,11 @@ def expand_modes(disc: Discretisation, C, omega, shapes, noise: float = DEFAULT_
 
 
 def _tikhonov_discrepancy(G, y, noise):
-    """min ||G λ - y||² + α²||λ||² with α chosen so that ||G λ - y|| = noise ||y||."""
+    """min ||G λ - y||² + α²||λ||² with α chosen so that ||G λ - y|| equals the expected
+    norm of the noise, ``noise * max|y| * sqrt(n_sensors)``."""
     u, s, vt = np.linalg.svd(G)
     beta = u.T @ y
-    target = noise * np.linalg.norm(y)
+    target = noise * np.max(np.abs(y)) * np.sqrt(y.size)
 
     def misfit(alpha):
         return np.linalg.norm(alpha**2 / (s**2 + alpha**2) * beta)

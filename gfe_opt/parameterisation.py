@@ -6,7 +6,8 @@ Each parameterisation is linear, :math:`p = A q` with ``p`` the stacked element 
 * ``element``: every element's own (k_ww, k_wt, k_tt), 3N parameters (eq. 11);
 * ``nodal``: nodal bending stiffness k_i and slope ∂k_i/∂x, 2N+2 parameters (eq. 13);
 * ``linear``: k_i only, k varying linearly in each element (eq. 23), N+1 parameters;
-* ``constant``: one k per element, k_ww = 12k, k_wt = 6k, k_tt = 4k, N parameters.
+* ``constant``: one k per element, k_ww = 12k, k_wt = 6k, k_tt = 4k, N parameters;
+* bars: ``element`` (k = EA per element) and ``nodal`` (eq. 7 with c1 = c2 = 1/2).
 
 Eq. 13 is derived here (:func:`derive_nodal_coefficients`) as the exact integral
 :math:`\int_0^1 EI(ξ) N''N''^T dξ` of a cubic-Hermite interpolated EI(x) with nodal values
@@ -20,8 +21,8 @@ from functools import lru_cache
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 import sympy
-from scipy.sparse.linalg import lsqr
 
 PARAMETERISATIONS = ("element", "nodal", "linear", "constant")
 
@@ -40,27 +41,41 @@ def derive_nodal_coefficients() -> sympy.Matrix:
     return sympy.Matrix(rows)
 
 
+BEAM_KEYS = ("k_ww", "k_wt", "k_tt")
+BAR_KEYS = ("k",)
+
+
 @dataclass(frozen=True)
 class Parameterisation:
-    """A linear map q -> stacked element parameters ``[k_ww, k_wt, k_tt]`` (3N,)."""
+    """A linear map q -> stacked element parameters, ``[k_ww, k_wt, k_tt]`` (3N,) for a
+    beam or ``[k]`` (N,) for a bar."""
 
     name: str
-    matrix: sp.csr_matrix  # (3N, n_q)
+    matrix: sp.csr_matrix  # (len(keys) N, n_q)
     labels: tuple[str, ...]
+    keys: tuple[str, ...] = BEAM_KEYS
 
     @property
     def n_params(self) -> int:
         return self.matrix.shape[1]
 
+    @property
+    def n_elements(self) -> int:
+        return self.matrix.shape[0] // len(self.keys)
+
     def element_parameters(self, q) -> dict:
         p = self.matrix @ np.asarray(q, float)
-        n = self.matrix.shape[0] // 3
-        return {"k_ww": p[:n], "k_wt": p[n:2 * n], "k_tt": p[2 * n:]}
+        n = self.n_elements
+        return {k: p[i * n:(i + 1) * n] for i, k in enumerate(self.keys)}
 
     def fit(self, params: dict) -> np.ndarray:
         """The q whose element parameters are closest (least squares) to ``params``."""
-        target = np.concatenate([params["k_ww"], params["k_wt"], params["k_tt"]])
-        return lsqr(self.matrix, target, atol=1e-14, btol=1e-14)[0]
+        target = np.concatenate([params[k] for k in self.keys])
+        A = self.matrix
+        try:
+            return spla.spsolve((A.T @ A).tocsc(), A.T @ target)
+        except RuntimeError:  # rank-deficient: minimum-norm least squares
+            return spla.lsqr(A, target, atol=1e-15, btol=1e-15)[0]
 
 
 def beam_parameterisation(name: str, n_elements: int, element_length: float) -> Parameterisation:
@@ -100,3 +115,30 @@ def beam_parameterisation(name: str, n_elements: int, element_length: float) -> 
                                                     shape=(3 * n, n)),
                                 tuple(f"k[{i}]" for i in range(n)))
     raise ValueError(f"unknown parameterisation {name!r} (one of {', '.join(PARAMETERISATIONS)})")
+
+
+BAR_PARAMETERISATIONS = ("element", "nodal")
+
+
+def bar_parameterisation(name: str, n_elements: int) -> Parameterisation:
+    """Bar axial stiffness k = EA per element (``element``, N) or from nodal values with
+    eq. 7, :math:`k^{j} = (k_{i-1} + k_i)/2` (c1 = c2 = 1/2, ``nodal``, N+1)."""
+    n = n_elements
+    e = np.arange(n)
+    if name == "element":
+        return Parameterisation(name, sp.identity(n, format="csr"),
+                                tuple(f"k[{i}]" for i in range(n)), BAR_KEYS)
+    if name == "nodal":
+        A = sp.csr_matrix((np.full(2 * n, 0.5), (np.repeat(e, 2), np.stack([e, e + 1], 1).ravel())),
+                          shape=(n, n + 1))
+        return Parameterisation(name, A, tuple(f"k[{i}]" for i in range(n + 1)), BAR_KEYS)
+    raise ValueError(f"unknown bar parameterisation {name!r} "
+                     f"(one of {', '.join(BAR_PARAMETERISATIONS)})")
+
+
+def parameterisation_for(kind: str, name: str, n_elements: int,
+                         element_length: float) -> Parameterisation:
+    """The named parameterisation of a beam or a bar."""
+    if kind == "bar":
+        return bar_parameterisation(name, n_elements)
+    return beam_parameterisation(name, n_elements, element_length)

@@ -31,6 +31,31 @@ def reference_discretisation(truth: Model, elements: int):
     return disc.with_stiffness(params)
 
 
+def reference_with_rigidity(model: Model, rigidity, elements: int):
+    """Fine-mesh discretisation of ``model`` with bending rigidity EI(x) = ``rigidity(x)``
+    integrated element by element with Hermite curvatures (an independent route from the
+    parameterisations being updated)."""
+    fine = model.with_elements(elements)
+    disc = discretise(fine)
+    L = fine.element_length
+    k = np.array([el.beam_stiffness_from_rigidity(rigidity, e * L, L)
+                  for e in range(elements)])
+    return disc.with_stiffness({"k_ww": k[:, 0], "k_wt": k[:, 1], "k_tt": k[:, 2]})
+
+
+def full_shapes_at_nodes(reference, model: Model, n_modes: int):
+    """Frequencies [Hz] and all-DOF shapes of a fine ``reference`` sampled at the nodes of
+    ``model`` (whose element count must divide the reference's)."""
+    ratio = reference.n_elements // model.elements
+    if ratio * model.elements != reference.n_elements:
+        raise ValueError("reference elements must be a multiple of the model's")
+    modes = discretisation_modes(reference, n_modes)
+    nodes = np.arange(model.elements + 1) * ratio
+    per = reference.dofs_per_node
+    dofs = (nodes[:, None] * per + np.arange(per)).ravel()
+    return modes.frequencies_hz, modes.shapes[dofs]
+
+
 def synthetic_measurement(truth: Model, n_modes: int, sensors, *, shape_noise=0.0,
                           freq_noise=0.0, seed=0, reference_elements: int | None = None,
                           ) -> MeasuredModes:

@@ -1,0 +1,123 @@
+"""Equation-error updating: recovery of known rigidity, the case-study crack, IPOPT vs SDP."""
+
+import numpy as np
+import pytest
+
+from gfe_opt import elements as el
+from gfe_opt.assembly import discretise
+from gfe_opt.measured import make_measured
+from gfe_opt.model import Effect
+from gfe_opt.parameterisation import beam_parameterisation
+from gfe_opt.synthetic import (full_shapes_at_nodes, reference_with_rigidity,
+                               synthetic_measurement)
+from gfe_opt.updating import update_generic, update_sdp
+
+from .conftest import make_model
+
+
+def _all_dof_data(model, rigidity, n_modes, ratio=8):
+    """Noise-free modes of an independent fine reference, every DOF at the model's nodes."""
+    ref = reference_with_rigidity(model, rigidity, ratio * model.elements)
+    freqs, shapes = full_shapes_at_nodes(ref, model, n_modes)
+    measured = make_measured(model.nodes[1:-1], "w", freqs, shapes[2:-2:2], "reference")
+    return measured, shapes
+
+
+def _taper(model):
+    return lambda x: model.bending_rigidity * (1 + 0.5 * x / model.length)
+
+
+def _dip(model):
+    return lambda x: model.bending_rigidity * (
+        1 - 0.3 * np.exp(-(((x - 0.35 * model.length) / (0.08 * model.length)) ** 2)))
+
+
+def _assert_physical(result):
+    assert result.ok, result.summary()
+    p = result.element_parameters
+    K = el.generic_beam_stiffness(p["k_ww"], p["k_wt"], p["k_tt"])
+    lam = np.linalg.eigvalsh(K)
+    assert np.all(lam[:, :2] > -1e-9 * lam[:, -1:])   # semidefinite
+    assert np.all(lam[:, 2] > 1e-6 * lam[:, -1])       # exactly two zero eigenvalues
+    assert np.allclose(np.einsum("eij,jk->eik", K, el.BEAM_RIGID_MODES), 0.0,
+                       atol=1e-9 * np.abs(K).max())
+
+
+@pytest.mark.parametrize("shape,parameterisation,tol", [
+    ("taper", "nodal", 0.01), ("taper", "linear", 0.005), ("taper", "element", 0.01),
+    ("dip", "nodal", 0.005), ("dip", "element", 0.005),
+])
+def test_recovers_smooth_rigidity_from_all_dof_modes(shape, parameterisation, tol):
+    model = make_model(elements=24)
+    rigidity = {"taper": _taper, "dip": _dip}[shape](model)
+    measured, shapes = _all_dof_data(model, rigidity, 4)
+    result = update_generic(model, measured, parameterisation=parameterisation,
+                            full_shapes=shapes, noise=0.0)
+    _assert_physical(result)
+    assert result.objective < 1e-2 * result.objective_initial
+    if parameterisation == "element":
+        L = model.element_length
+        exact = np.array([el.beam_stiffness_from_rigidity(rigidity, e * L, L)
+                          for e in range(model.elements)])
+        got = np.stack([result.element_parameters[k] for k in ("k_ww", "k_wt", "k_tt")], 1)
+        # the end elements of a pinned beam store little strain energy: held, not recovered
+        assert np.max(np.abs(got / exact - 1)[1:-1]) < tol
+    else:
+        k = result.q[:model.elements + 1]
+        assert np.max(np.abs(k / rigidity(model.nodes) - 1)) < tol
+
+
+def test_constant_parameterisation_cannot_hold_a_taper():
+    # the paper: k constant (or zero slope) per element is a zero-order estimate
+    model = make_model(elements=24)
+    measured, shapes = _all_dof_data(model, _taper(model), 4)
+    nodal = update_generic(model, measured, parameterisation="nodal", full_shapes=shapes,
+                           noise=0.0)
+    constant = update_generic(model, measured, parameterisation="constant", full_shapes=shapes,
+                              noise=0.0)
+    assert constant.objective > 100 * nodal.objective
+
+
+@pytest.mark.parametrize("seed", [4, 5])
+def test_case_study_crack_located_from_noisy_translations(seed):
+    model = make_model()  # 46 elements, sensors at the interior nodes, first mode only
+    truth = model.with_effects([Effect("crack", {"position": 0.2875, "depth_ratio": 2 / 3})])
+    measured = synthetic_measurement(truth, 1, model.nodes[1:-1], shape_noise=0.005,
+                                     freq_noise=0.0005, seed=seed)
+    result = update_generic(model, measured, noise=0.005)
+    _assert_physical(result)
+    k = result.element_parameters["k_ww"] / 12
+    centres = 0.5 * (model.nodes[:-1] + model.nodes[1:])
+    assert abs(centres[np.argmin(k)] - 0.2875) <= model.element_length
+    assert k.min() < 0.5 * model.bending_rigidity
+
+
+def test_ipopt_and_sdp_agree_on_a_convex_instance():
+    model = make_model(elements=20)
+    measured, shapes = _all_dof_data(model, _dip(model), 3)
+    a = update_generic(model, measured, full_shapes=shapes, noise=0.0)
+    b = update_sdp(model, measured, full_shapes=shapes, noise=0.0)
+    assert a.ok and b.ok
+    assert np.isclose(a.objective, b.objective, rtol=1e-6)
+    assert np.max(np.abs(a.q - b.q)) < 1e-5 * np.max(np.abs(a.q))
+
+
+def test_infeasible_start_is_handled():
+    model = make_model(elements=20)
+    measured, shapes = _all_dof_data(model, _taper(model), 3)
+    par = beam_parameterisation("element", 20, model.element_length)
+    q0 = par.fit(discretise(model).stiffness_params)
+    q0[3] = -q0[3]  # element 3: k_ww < 0, indefinite
+    assert el.feasibility_violations(el.BEAM_STIFFNESS_CONDITIONS, par.element_parameters(q0))
+    result = update_generic(model, measured, parameterisation=par, full_shapes=shapes,
+                            noise=0.0, q0=q0)
+    _assert_physical(result)
+
+
+def test_failed_solve_is_reported_not_hidden():
+    model = make_model(elements=20)
+    measured, shapes = _all_dof_data(model, _dip(model), 3)
+    result = update_generic(model, measured, full_shapes=shapes, noise=0.0, max_iter=2)
+    assert not result.success and not result.ok
+    assert "Maximum_Iterations" in result.status
+    assert any("must not be used" in n for n in result.notes)
