@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import shutil
-from importlib import resources
 from pathlib import Path
 
 from .cli import format_comparison
@@ -11,15 +10,11 @@ from .correlation import compare
 from .errors import GfeInputError
 from .measured import save_measured
 from .model import Effect, load_model
+from .problems import problem_file
 from .synthetic import interior_sensors, synthetic_measurement
 
 #: The hidden truth of the demo: a crack the starting model does not have.
 DEMO_CRACK = {"position": 0.19, "depth_ratio": 0.5}
-
-
-def problem_file(name: str) -> Path:
-    """Path of a shipped problem file (``problems/`` in the source tree)."""
-    return Path(str(resources.files("gfe_opt.problems").joinpath(name)))
 
 
 def run_demo(out: Path, force: bool = False) -> int:

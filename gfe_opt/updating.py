@@ -29,16 +29,24 @@ Incomplete measurements
 -----------------------
 Measured shapes are translations at sensors.  Two treatments:
 
-* ``"expand"`` (default): shapes are first expanded with the initial model
+* ``"expand"`` (default): shapes are expanded with the model
   (:func:`~gfe_opt.correlation.expand_modes`, regularised by the shape noise δ); J is then a
   convex quadratic in q, the form the cvxpy SDP cross-check (:func:`update_sdp`) solves too.
-  Default because it is convex and robust: on the case study (0.5 % noise) IPOPT converges
-  in about 20 iterations and locates the crack.
+  The expansion is then repeated with the *updated* model and the convex problem re-solved
+  (``refinements``, default 2): a block-coordinate treatment of the bilinear problem.
+  Default because each step is convex and robust: on the case study (0.5 % noise) each IPOPT
+  solve takes about 20 iterations and the crack is located.
 * ``"bilinear"``: the free-DOF shapes :math:`φ_j` are decision variables next to q, with
   the data term :math:`\frac{1}{δ^2 n_s m}\sum_j \|Cφ_j - y_j\|^2` (y_j scaled to unit
   norm), started from the ``expand`` solution, so unmeasured DOFs are estimated with the
   *updated* model.  Measured weakness: on the noisy case study IPOPT often stops at its
   iteration limit; the result then says so (``ok`` False) and is not to be used.
+
+Modal energy balance (explicit equality, linear in q): for the shapes used,
+:math:`φ_j^T K(q) φ_j = ω_j^2 φ_j^T M φ_j`, so the updated model's Rayleigh quotient at each
+measured shape is the measured eigenvalue.  Without it the equation error alone can be made
+small by an over-softened zone whose first frequency is 20-65 % low (measured on the case
+study); with it and two refinements the updated first frequency is within 0.01 %.
 
 Constraints (IPOPT, explicit): for every element :math:`k_{ww} \ge m k_0`,
 :math:`k_{θθ} \ge m k_0`, :math:`k_{ww}k_{θθ} - k_{wθ}^2 \ge m k_0^2` (bar: :math:`k \ge m
@@ -226,13 +234,17 @@ def _node_energy_share(disc: Discretisation, shapes_full) -> np.ndarray:
     return node / np.maximum(node.mean(axis=0), 1e-300)
 
 
-def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes=None):
+def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes=None,
+             expansion_params=None):
+    """Problem data; shapes are expanded with ``disc`` or, when given, with its stiffness
+    replaced by ``expansion_params`` (the current updated model)."""
     free = disc.free
     K_full, M_full = disc.global_matrices()
     C_full = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
     y = measured.shapes / np.linalg.norm(measured.shapes, axis=0)
     if full_shapes is None:
-        phi_full = expand_modes(disc, C_full, measured.omega, y, noise, K_full, M_full).shapes
+        expander = disc if expansion_params is None else disc.with_stiffness(expansion_params)
+        phi_full = expand_modes(expander, C_full, measured.omega, y, noise).shapes
     else:
         phi_full = np.asarray(full_shapes, float)
         if phi_full.shape != (disc.n_dof, measured.n_modes):
@@ -331,6 +343,19 @@ def _expanded_least_squares(pb: _Problem):
     return sp.vstack(blocks).tocsr(), np.concatenate(consts), reg
 
 
+def _energy_balance(pb: _Problem):
+    """Rows (A, b) of the modal energy balance φ_jᵀ K(q) φ_j = ω_j² φ_jᵀ M φ_j (fixed φ_j),
+    divided by the right-hand side: ``A q + b = 0``, linear in q."""
+    K_extra = pb.kmap.extra_matrix()
+    rows, rhs = [], []
+    for j in range(pb.omega.size):
+        phi = pb.phi0[:, j]
+        kinetic = pb.omega[j] ** 2 * phi @ (pb.M @ phi)
+        rows.append((phi @ pb.kmap.jacobian_times(phi)) / kinetic)
+        rhs.append((phi @ (K_extra @ phi)) / kinetic - 1.0)
+    return np.array(rows), np.array(rhs)
+
+
 def _constraints(pb: _Problem, q):
     """Element feasibility constraints g(q) >= margin (CasADi expressions), scaled by k0."""
     p = ca.mtimes(_dm(pb.par.matrix), q) / pb.k0
@@ -352,14 +377,16 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
                    parameterisation: str | Parameterisation = "nodal", method: str = "expand",
                    noise: float = DEFAULT_SHAPE_NOISE, regularisation: float | None = None,
                    margin: float = 1e-3, q0=None, max_iter: int = 500,
-                   full_shapes=None) -> UpdateResult:
+                   full_shapes=None, refinements: int = 2) -> UpdateResult:
     """Update generic stiffness parameters by the equation error (see module docstring).
 
     ``model`` is the initial model (or its discretisation); ``q0`` may replace its parameter
     values as the starting point (it may violate the constraints).  ``full_shapes``
-    (n_dof, n_modes), when every DOF was measured, replaces the expansion.  ``bilinear``
-    starts from the ``expand`` solution.  Never raises for a failed solve: the result's
-    ``success``/``status`` say so and ``ok`` is False.
+    (n_dof, n_modes), when every DOF was measured, replaces the expansion.  With ``expand``,
+    ``refinements`` re-expansions with the updated model follow the first solve (each
+    re-solves the convex problem; the regularisation stays anchored at the initial model).
+    ``bilinear`` starts from the ``expand`` solution.  Never raises for a failed solve: the
+    result's ``success``/``status`` say so and ``ok`` is False.
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r} (one of {', '.join(METHODS)})")
@@ -370,13 +397,24 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
         parameterisation_for(disc.kind, parameterisation, disc.n_elements, disc.element_length)
     start = time.perf_counter()
     pb = _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes)
-    q_start, notes = pb.q0, []
+    notes = []
+    (success, status, info), (q_opt, phi_opt) = _solve_ipopt(pb, "expand", pb.q0, max_iter)
+    for done in range(refinements if full_shapes is None else 0):
+        if not success:
+            break
+        pb = _prepare(disc, par, measured, noise, regularisation, margin, q0, None,
+                      expansion_params=par.element_parameters(q_opt))
+        (success, status, info), (q_new, phi_opt) = _solve_ipopt(pb, "expand", q_opt,
+                                                                 max_iter)
+        step = np.max(np.abs(q_new - q_opt) / pb.scale)
+        q_opt = q_new
+        info["refinements"] = done + 1
+        if step < 1e-6:
+            break
     if method == "bilinear":
-        first, q_start = _solve_ipopt(pb, "expand", pb.q0, max_iter)
-        if not first[0]:
-            notes.append(f"the expand start did not converge ({first[1]})")
-        q_start = q_start[0]
-    (success, status, info), (q_opt, phi_opt) = _solve_ipopt(pb, method, q_start, max_iter)
+        if not success:
+            notes.append(f"the expand start did not converge ({status})")
+        (success, status, info), (q_opt, phi_opt) = _solve_ipopt(pb, method, q_opt, max_iter)
     return _finish(pb, method, "ipopt", q_opt, phi_opt, status, success, info,
                    time.perf_counter() - start, notes)
 
@@ -415,13 +453,18 @@ def _solve_ipopt(pb: _Problem, method: str, q_start, max_iter: int):
         J += misfit / (max(pb.noise, 1e-6) ** 2 * pb.y.size)
     # -- constraints ----------------------------------------------------------------------
     g = _constraints(pb, q)
+    lbg, ubg = np.full(g.shape[0], pb.margin), np.full(g.shape[0], np.inf)
+    if method == "expand":
+        A, b = _energy_balance(pb)
+        g = ca.vertcat(g, ca.mtimes(ca.DM(A), q) + b)
+        lbg, ubg = np.concatenate([lbg, np.zeros(b.size)]), np.concatenate([ubg, np.zeros(b.size)])
     # -- solve ----------------------------------------------------------------------------
     solver = ca.nlpsol("equation_error", "ipopt", {"x": ca.vertcat(*variables), "f": J, "g": g},
                        {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
                         "ipopt.max_iter": max_iter, "ipopt.tol": 1e-10,
                         "ipopt.acceptable_tol": 1e-8})
     try:
-        sol = solver(x0=np.concatenate(start_values), lbg=pb.margin, ubg=np.inf)
+        sol = solver(x0=np.concatenate(start_values), lbg=lbg, ubg=ubg)
     except RuntimeError as exc:  # CasADi raises on evaluation errors
         raise GfeSolverError(f"IPOPT failed: {exc}") from exc
     stats = solver.stats()
@@ -429,7 +472,7 @@ def _solve_ipopt(pb: _Problem, method: str, q_start, max_iter: int):
     q_opt = pb.scale * xs[:n_q]
     phi_opt = pb.phi0 if method == "expand" else \
         xs[n_q:].reshape((n_free, m), order="F") * phi_scale[:, None]
-    info = {k: stats.get(k) for k in ("return_status", "iter_count", "t_wall_total")}
+    info = {k: stats.get(k) for k in ("return_status", "iter_count")}
     return ((bool(stats.get("success")), str(stats.get("return_status")), info),
             (q_opt, phi_opt))
 
@@ -467,6 +510,8 @@ def update_sdp(model: Model | Discretisation, measured: MeasuredModes, *,
     else:
         constraints = [cp.bmat([[p[e], p[n + e]], [p[n + e], p[2 * n + e]]]) >> margin * np.eye(2)
                        for e in range(n)]
+    A, b_energy = _energy_balance(pb)
+    constraints.append((A @ sp.diags(pb.scale)) @ z + b_energy == 0)
     problem = cp.Problem(cp.Minimize(objective), constraints)
     if not problem.is_dcp():
         raise GfeSolverError("the SDP variant is not DCP (a formulation bug)")

@@ -13,9 +13,9 @@ import time
 import numpy as np
 
 from gfe_opt.assembly import discretise
-from gfe_opt.demo import problem_file
 from gfe_opt.modal import discretisation_modes, solve_modes
 from gfe_opt.model import load_model
+from gfe_opt.problems import problem_file
 
 
 def main():

@@ -7,9 +7,9 @@ import sys
 import pytest
 
 from gfe_opt.cli import main
-from gfe_opt.demo import problem_file
 from gfe_opt.measured import save_measured
 from gfe_opt.model import Effect, load_model
+from gfe_opt.problems import problem_file
 from gfe_opt.synthetic import interior_sensors, synthetic_measurement
 
 

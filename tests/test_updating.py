@@ -8,8 +8,7 @@ from gfe_opt.assembly import discretise
 from gfe_opt.measured import make_measured
 from gfe_opt.model import Effect
 from gfe_opt.parameterisation import beam_parameterisation
-from gfe_opt.synthetic import (full_shapes_at_nodes, reference_with_rigidity,
-                               synthetic_measurement)
+from gfe_opt.synthetic import full_shapes_at_nodes, reference_with_rigidity, synthetic_measurement
 from gfe_opt.updating import update_generic, update_sdp
 
 from .conftest import make_model
