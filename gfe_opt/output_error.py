@@ -20,21 +20,23 @@ from scipy.optimize import least_squares
 
 from .assembly import Discretisation, discretise
 from .correlation import DEFAULT_SHAPE_NOISE, mac, pair_modes
+from .errors import GfeSolverError
 from .measured import MeasuredModes
 from .modal import discretisation_modes
 from .model import Model
 from .parameterisation import Parameterisation, parameterisation_for
-from .updating import UpdateResult, _finish, _prepare, default_regularisation
+from .updating import UpdateResult, _finish, _prepare
 
 
 def update_output_error(model: Model | Discretisation, measured: MeasuredModes, *,
                         parameterisation: str | Parameterisation = "nodal",
                         noise: float = DEFAULT_SHAPE_NOISE,
-                        regularisation: float | None = None, margin: float = 1e-3,
+                        regularisation: float = 1e-4, margin: float = 1e-3,
                         extra_modes: int = 12, max_nfev: int = 200) -> UpdateResult:
-    """Output-error update of the same parameters (see module docstring)."""
-    if regularisation is None:
-        regularisation = default_regularisation(noise)
+    """Output-error update of the same parameters (see module docstring).
+
+    ``regularisation`` weighs the same rows as the equation error's, against residuals that
+    are relative frequency and shape errors (hence a smaller default)."""
     disc = discretise(model) if isinstance(model, Model) else model
     par = parameterisation if isinstance(parameterisation, Parameterisation) else \
         parameterisation_for(disc.kind, parameterisation, disc.n_elements, disc.element_length)
@@ -80,14 +82,15 @@ def update_output_error(model: Model | Discretisation, measured: MeasuredModes, 
         jac.append(np.diag(reg))
         return np.concatenate(res), np.vstack(jac)
 
-    cache = {}
+    cache = {"z": None}
 
     def fun(z):
-        cache["z"], (cache["r"], cache["J"]) = z.copy(), residual_and_jacobian(z)
+        cache["r"], cache["J"] = residual_and_jacobian(z)
+        cache["z"] = z.copy()
         return cache["r"]
 
     def jac(z):
-        if "z" not in cache or not np.array_equal(cache["z"], z):
+        if cache["z"] is None or not np.array_equal(cache["z"], z):
             fun(z)
         return cache["J"]
 
@@ -95,8 +98,16 @@ def update_output_error(model: Model | Discretisation, measured: MeasuredModes, 
     stiff = np.array([not lab.startswith(("dk/dx", "k_wt")) for lab in par.labels])
     lower[stiff] = margin * pb.k0 / pb.scale[stiff]
     x0 = np.maximum(z0, lower + 1e-12)
-    sol = least_squares(fun, x0, jac=jac, bounds=(lower, np.inf), method="trf",
-                        max_nfev=max_nfev, x_scale="jac")
+    try:
+        sol = least_squares(fun, x0, jac=jac, bounds=(lower, np.inf), method="trf",
+                            max_nfev=max_nfev, x_scale="jac")
+    except GfeSolverError as exc:
+        # no positivity constraints here: an iterate can make an element indefinite
+        stats = {"return_status": str(exc), "iter_count": counter["eig"],
+                 "eigen_solves": counter["eig"]}
+        return _finish(pb, "expand", "output-error", pb.scale * cache["z"], pb.phi0,
+                       "indefinite model reached", False, stats,
+                       time.perf_counter() - start, [f"stopped: {exc}"])
     stats = {"return_status": sol.message, "iter_count": int(sol.nfev),
              "eigen_solves": counter["eig"], "cost": float(sol.cost)}
     return _finish(pb, "expand", "output-error", pb.scale * sol.x, pb.phi0,

@@ -1,0 +1,37 @@
+"""Every script runs (small, in a temporary folder) and prints what it promises."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
+
+
+def _run(name, *args, cwd):
+    return subprocess.run([sys.executable, str(SCRIPTS / name), *args], capture_output=True,
+                          text=True, cwd=cwd, check=True).stdout
+
+
+def test_paper_case_study(tmp_path):
+    out = _run("paper_case_study.py", "--out", str(tmp_path / "cs"), cwd=tmp_path)
+    rows = json.loads(out[:out.rindex("]") + 1])
+    assert {p.name for p in (tmp_path / "cs").iterdir()} == {
+        "fig1_k.png", "fig2_dkdx.png", "fig3_linear.png", "fig4_constant.png", "fig5_q.png"}
+    for row in rows:
+        assert row["ok"]
+        if row["elements"] in (46, 92):  # crack at a node: located within one element
+            assert abs(row["lowest_k_at_m"] - 0.2875) <= 0.575 / row["elements"]
+
+
+def test_compare_solvers(tmp_path):
+    out = _run("compare_solvers.py", cwd=tmp_path)
+    rows = json.loads(out[out.index("["):])
+    assert len(rows) == 9
+    taper = [r for r in rows if r["problem"].startswith("tapered")]
+    assert all(r["ok"] for r in taper)
+
+
+def test_bench_eigen_accuracy(tmp_path):
+    rows = json.loads(_run("bench_eigen_accuracy.py", cwd=tmp_path))
+    assert rows[-1]["gfe_opt_max_rel_error"] < 1e-6 < rows[-1]["raw_shift_invert_max_rel_error"]
