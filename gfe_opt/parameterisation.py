@@ -73,9 +73,9 @@ class Parameterisation:
         target = np.concatenate([params[k] for k in self.keys])
         A = self.matrix
         try:
-            return spla.spsolve((A.T @ A).tocsc(), A.T @ target)
-        except RuntimeError:  # rank-deficient: minimum-norm least squares
-            return spla.lsqr(A, target, atol=1e-15, btol=1e-15)[0]
+            return spla.splu((A.T @ A).tocsc()).solve(A.T @ target)
+        except RuntimeError:  # rank-deficient (e.g. a bar's nodal k): minimum-norm solution
+            return spla.lsqr(A, target, atol=1e-15, btol=1e-15, iter_lim=10 * A.shape[1])[0]
 
 
 def beam_parameterisation(name: str, n_elements: int, element_length: float) -> Parameterisation:

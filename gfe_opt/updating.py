@@ -58,7 +58,7 @@ built into the ``nodal``, ``linear`` and ``constant`` parameterisations (eq. 13)
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import casadi as ca
 import numpy as np
@@ -166,6 +166,74 @@ def stiffness_map(disc: Discretisation, par: Parameterisation) -> StiffnessMap:
     return StiffnessMap(pattern=pattern, S=(S_p @ par.matrix).tocsr(), extra=extra)
 
 
+MASS_NAMES = {"beam": ("m11", "m12", "m14", "m22"), "bar": ("beta",)}
+MASS_MARGIN = 1e-6
+
+
+@dataclass(frozen=True)
+class MassMap:
+    """Uniform generic mass parameters (eq. 17 m11, m12, m14, m22; bar eq. 2 β):
+    M_ff(m) = ``rest + Σ_b m_b basis[b]`` and element matrices likewise."""
+
+    names: tuple
+    m0: np.ndarray
+    basis: tuple           # free-DOF global matrices ∂M/∂m_b
+    rest: sp.csc_matrix    # M_ff at m = 0
+    element_basis: np.ndarray   # (n_b, n_elements, n, n) physical
+    element_rest: np.ndarray    # (n_elements, n, n)
+
+    def matrix(self, m) -> sp.csc_matrix:
+        out = self.rest.copy()
+        for value, b in zip(m, self.basis):
+            out = out + value * b
+        return out.tocsc()
+
+    def elements(self, m) -> np.ndarray:
+        return self.element_rest + np.tensordot(np.asarray(m, float), self.element_basis, 1)
+
+    def conditions(self, m) -> list:
+        """Feasibility values (each must exceed MASS_MARGIN), numpy or CasADi."""
+        if self.names == ("beta",):
+            return [0.25 - m[0]]
+        p = dict(zip(self.names, (m[i] for i in range(4))))
+        return [c.value(p) for c in el.SYMMETRIC_BEAM_MASS_CONDITIONS]
+
+
+def mass_map(disc: Discretisation) -> MassMap:
+    """The mass of ``disc`` as a uniform generic family around its present parameters."""
+    L = disc.element_length
+    if disc.kind == "bar":
+        t = np.array([1.0, 1.0])
+        scaled_basis = [el.BAR_MASS_BASIS["beta"]]
+        tt = np.ones((2, 2))
+    else:
+        t = np.array([1.0, 0.0, 1.0, 0.0])
+        scaled_basis = [el.SYMMETRIC_BEAM_MASS_BASIS[k] for k in MASS_NAMES["beam"]]
+        scale = el.beam_dof_scaling(L)
+        tt = np.outer(scale, scale)
+    total = np.einsum("i,eij,j->e", t, disc.mass, t)  # ρ A L of each element
+    element_basis = np.array([total[:, None, None] * (b * tt) for b in scaled_basis])
+    # present parameters: least squares of the element matrices on the basis (mean element)
+    design = element_basis.reshape(len(scaled_basis), -1).T
+    m0 = np.linalg.lstsq(design, disc.mass.ravel() - _constant_part(disc, total, tt),
+                         rcond=None)[0]
+    element_rest = disc.mass - np.tensordot(m0, element_basis, 1)
+    free = disc.free
+
+    def global_free(elements):
+        return sp.csc_matrix(disc.assemble_elements(elements))[free][:, free]
+
+    return MassMap(names=MASS_NAMES[disc.kind], m0=m0,
+                   basis=tuple(global_free(b) for b in element_basis),
+                   rest=global_free(element_rest), element_basis=element_basis,
+                   element_rest=element_rest)
+
+
+def _constant_part(disc, total, tt):
+    constant = el.BAR_MASS_CONSTANT if disc.kind == "bar" else el.SYMMETRIC_BEAM_MASS_CONSTANT
+    return (total[:, None, None] * (constant * tt)).ravel()
+
+
 @dataclass
 class UpdateResult:
     """Outcome of an equation-error update.  ``ok`` is False for any failed or unphysical solve."""
@@ -189,6 +257,8 @@ class UpdateResult:
     shapes: np.ndarray | None = None
     notes: list = field(default_factory=list)
     scale: np.ndarray | None = None
+    mass_parameters: dict | None = None
+    mass_parameters_initial: dict | None = None
 
     @property
     def ok(self) -> bool:
@@ -227,6 +297,39 @@ class _Problem:
     regularisation: float
     margin: float
     eq_scale: float = 1.0
+    mmap: MassMap | None = None
+
+    # x = [q; m]: stiffness parameters, then (optionally) uniform mass parameters
+    @property
+    def n_q(self) -> int:
+        return self.q0.size
+
+    @property
+    def x0(self) -> np.ndarray:
+        return self.q0 if self.mmap is None else np.concatenate([self.q0, self.mmap.m0])
+
+    @property
+    def x_scale(self) -> np.ndarray:
+        extra = 0 if self.mmap is None else len(self.mmap.names)
+        return np.concatenate([self.scale, np.full(extra, 0.1)])
+
+    @property
+    def x_weights(self) -> np.ndarray:
+        extra = 0 if self.mmap is None else len(self.mmap.names)
+        return np.concatenate([self.param_weights, np.ones(extra)])
+
+    def mass_matrix(self, x) -> sp.csc_matrix:
+        return self.M if self.mmap is None else self.mmap.matrix(x[self.n_q:])
+
+    def jacobian(self, j: int, phi):
+        """(A, c) with (K(q) - ω_j² M(m)) φ = A x + c for a fixed φ (free DOFs)."""
+        w2 = self.omega[j] ** 2
+        A = self.kmap.jacobian_times(phi)
+        c = self.kmap.extra_matrix() @ phi
+        if self.mmap is None:
+            return A, c - w2 * (self.M @ phi)
+        H = np.stack([b @ phi for b in self.mmap.basis], axis=1)
+        return sp.hstack([A, sp.csr_matrix(-w2 * H)]).tocsr(), c - w2 * (self.mmap.rest @ phi)
 
 
 def _node_energy_share(disc: Discretisation, shapes_full) -> np.ndarray:
@@ -239,15 +342,15 @@ def _node_energy_share(disc: Discretisation, shapes_full) -> np.ndarray:
 
 
 def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes=None,
-             expansion_params=None):
-    """Problem data; shapes are expanded with ``disc`` or, when given, with its stiffness
-    replaced by ``expansion_params`` (the current updated model)."""
+             expansion_disc=None, update_mass=False):
+    """Problem data; shapes are expanded with ``disc`` or, when given, ``expansion_disc``
+    (the current updated model)."""
     free = disc.free
     K_full, M_full = disc.global_matrices()
     C_full = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
     y = measured.shapes / np.linalg.norm(measured.shapes, axis=0)
     if full_shapes is None:
-        expander = disc if expansion_params is None else disc.with_stiffness(expansion_params)
+        expander = disc if expansion_disc is None else expansion_disc
         phi_full = expand_modes(expander, C_full, measured.omega, y, noise).shapes
     else:
         phi_full = np.asarray(full_shapes, float)
@@ -279,41 +382,60 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
     pb = _Problem(disc=disc, par=par, kmap=kmap, M=M, C=C, omega=measured.omega, y=y,
                   phi0=phi_full[free], row_weights=row_weights, q0=np.asarray(q0, float),
                   scale=scale, param_weights=param_weights, k0=k0, noise=noise,
-                  regularisation=regularisation, margin=margin)
+                  regularisation=regularisation, margin=margin,
+                  mmap=mass_map(disc) if update_mass else None)
     K0 = pb.kmap.matrix(pb.q0)
     r0 = row_weights * (K0 @ pb.phi0 - measured.omega**2 * (M @ pb.phi0))
     pb.eq_scale = max(float(np.mean(r0**2)), 1e-300)
     return pb
 
 
-def _objective_terms(pb: _Problem, q, phi, data_term: bool):
-    """Numeric J and per-mode relative residuals for given q and free-DOF shapes."""
-    K = pb.kmap.matrix(q)
-    res = K @ phi - (pb.omega**2) * (pb.M @ phi)
+def _objective_terms(pb: _Problem, x, phi, data_term: bool):
+    """Numeric J and per-mode relative residuals for given x = [q; m] and free-DOF shapes."""
+    x = np.asarray(x, float)
+    K = pb.kmap.matrix(x[:pb.n_q])
+    res = K @ phi - (pb.omega**2) * (pb.mass_matrix(x) @ phi)
     weighted = pb.row_weights * res
     per_mode = np.linalg.norm(weighted, axis=0)
     J = np.mean(weighted**2) / pb.eq_scale
-    dz = (np.asarray(q) - pb.q0) / pb.scale
-    J += pb.regularisation / pb.q0.size * np.sum(pb.param_weights * dz**2)
+    dz = (x - pb.x0) / pb.x_scale
+    J += pb.regularisation / x.size * np.sum(pb.x_weights * dz**2)
     if data_term:
         mis = pb.C @ phi - pb.y
         J += np.sum(mis**2) / (pb.noise**2 * mis.size)
     return float(J), per_mode
 
 
-def _feasibility(pb: _Problem, params) -> list:
+def _feasibility(pb: _Problem, x) -> list:
     conds = el.BEAM_STIFFNESS_CONDITIONS if pb.disc.kind == "beam" else el.BAR_CONDITIONS[:1]
+    params = pb.par.element_parameters(x[:pb.n_q])
     scaled = {k: np.asarray(v) / pb.k0 for k, v in params.items()}
-    return el.feasibility_violations(conds, scaled)
+    found = el.feasibility_violations(conds, scaled)
+    if pb.mmap is not None:
+        m = x[pb.n_q:]
+        conds = el.BAR_CONDITIONS[1:] if pb.disc.kind == "bar" else \
+            el.SYMMETRIC_BEAM_MASS_CONDITIONS
+        p = dict(zip(pb.mmap.names, m))
+        found += el.feasibility_violations(conds, p)
+    return found
 
 
-def _finish(pb, method, solver, q, phi, status, success, stats, seconds, notes):
+def _updated_discretisation(pb: _Problem, x) -> Discretisation:
+    disc = pb.disc.with_stiffness(pb.par.element_parameters(x[:pb.n_q]))
+    if pb.mmap is not None:
+        disc = replace(disc, mass=pb.mmap.elements(x[pb.n_q:]))
+    return disc
+
+
+def _finish(pb, method, solver, x, phi, status, success, stats, seconds, notes):
+    x = np.asarray(x, float)
+    q = x[:pb.n_q]
     params = pb.par.element_parameters(q)
-    disc = pb.disc.with_stiffness(params)
+    disc = _updated_discretisation(pb, x)
     data_term = method == "bilinear"
-    J, per_mode = _objective_terms(pb, q, phi, data_term)
-    J0, per_mode0 = _objective_terms(pb, pb.q0, pb.phi0, data_term)
-    violations = _feasibility(pb, params)
+    J, per_mode = _objective_terms(pb, x, phi, data_term)
+    J0, per_mode0 = _objective_terms(pb, pb.x0, pb.phi0, data_term)
+    violations = _feasibility(pb, x)
     if not success:
         notes = notes + [f"the solver did not converge ({status}); parameters are its last "
                          "iterate and must not be used as an updated model"]
@@ -324,7 +446,11 @@ def _finish(pb, method, solver, q, phi, status, success, stats, seconds, notes):
                         objective_initial=J0, residual_per_mode=per_mode,
                         residual_per_mode_initial=per_mode0, status=status, success=success,
                         stats=stats, violations=violations, seconds=seconds, shapes=shapes,
-                        notes=notes, scale=pb.scale)
+                        notes=notes, scale=pb.scale,
+                        mass_parameters=None if pb.mmap is None else
+                        dict(zip(pb.mmap.names, x[pb.n_q:].tolist())),
+                        mass_parameters_initial=None if pb.mmap is None else
+                        dict(zip(pb.mmap.names, pb.mmap.m0.tolist())))
 
 
 # -------------------------------------------------------------------------------------------
@@ -333,41 +459,47 @@ def _finish(pb, method, solver, q, phi, status, success, stats, seconds, notes):
 
 
 def _expanded_least_squares(pb: _Problem):
-    """The ``expand`` objective as ``||B z + b||² + ||V (z - z0)||²`` in scaled z = q / s."""
-    K_extra = pb.kmap.extra_matrix()
+    """The ``expand`` objective as ``||B z + b||² + ||V (z - z0)||²`` in scaled z = x / s."""
     blocks, consts = [], []
     norm = np.sqrt(pb.phi0.size * pb.eq_scale)
     for j in range(pb.omega.size):
-        G = pb.kmap.jacobian_times(pb.phi0[:, j])
-        const = K_extra @ pb.phi0[:, j] - pb.omega[j] ** 2 * (pb.M @ pb.phi0[:, j])
+        A, c = pb.jacobian(j, pb.phi0[:, j])
         w = pb.row_weights[:, j] / norm
-        blocks.append(sp.diags(w) @ G @ sp.diags(pb.scale))
-        consts.append(w * const)
-    reg = np.sqrt(pb.regularisation / pb.q0.size * pb.param_weights)
+        blocks.append(sp.diags(w) @ A @ sp.diags(pb.x_scale))
+        consts.append(w * c)
+    reg = np.sqrt(pb.regularisation / pb.x0.size * pb.x_weights)
     return sp.vstack(blocks).tocsr(), np.concatenate(consts), reg
 
 
 def _energy_balance(pb: _Problem):
-    """Rows (A, b) of the modal energy balance φ_jᵀ K(q) φ_j = ω_j² φ_jᵀ M φ_j (fixed φ_j),
-    divided by the right-hand side: ``A q + b = 0``, linear in q."""
-    K_extra = pb.kmap.extra_matrix()
+    """Rows (A, b) of the modal energy balance φ_jᵀ K(q) φ_j = ω_j² φ_jᵀ M(m) φ_j (fixed
+    φ_j), divided by the present kinetic term: ``A x + b = 0``, linear in x."""
     rows, rhs = [], []
     for j in range(pb.omega.size):
         phi = pb.phi0[:, j]
         kinetic = pb.omega[j] ** 2 * phi @ (pb.M @ phi)
-        rows.append((phi @ pb.kmap.jacobian_times(phi)) / kinetic)
-        rhs.append((phi @ (K_extra @ phi)) / kinetic - 1.0)
+        A, c = pb.jacobian(j, phi)
+        rows.append((A.T @ phi) / kinetic)
+        rhs.append((phi @ c) / kinetic)
     return np.array(rows), np.array(rhs)
 
 
-def _constraints(pb: _Problem, q):
-    """Element feasibility constraints g(q) >= margin (CasADi expressions), scaled by k0."""
-    p = ca.mtimes(_dm(pb.par.matrix), q) / pb.k0
+def _constraints(pb: _Problem, x):
+    """Feasibility constraints g(x) >= lower bounds (CasADi expressions): element stiffness
+    scaled by k0 (>= margin) and the mass conditions (>= MASS_MARGIN)."""
+    p = ca.mtimes(_dm(pb.par.matrix), x[:pb.n_q]) / pb.k0
     n = pb.par.n_elements
     if pb.disc.kind == "bar":
-        return p
-    ww, wt, tt = p[:n], p[n:2 * n], p[2 * n:]
-    return ca.vertcat(ww, tt, ww * tt - wt**2)
+        g = [p]
+    else:
+        ww, wt, tt = p[:n], p[n:2 * n], p[2 * n:]
+        g = [ww, tt, ww * tt - wt**2]
+    lower = [np.full(sum(e.shape[0] for e in g), pb.margin)]
+    if pb.mmap is not None:
+        mass = pb.mmap.conditions(x[pb.n_q:])
+        g += mass
+        lower.append(np.full(len(mass), MASS_MARGIN))
+    return ca.vertcat(*g), np.concatenate(lower)
 
 
 def _dm(matrix) -> ca.DM:
@@ -381,7 +513,8 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
                    parameterisation: str | Parameterisation = "nodal", method: str = "expand",
                    noise: float = DEFAULT_SHAPE_NOISE, regularisation: float | None = None,
                    margin: float = 1e-3, q0=None, max_iter: int = 500,
-                   full_shapes=None, refinements: int = 2) -> UpdateResult:
+                   full_shapes=None, refinements: int = 2,
+                   update_mass: bool = False) -> UpdateResult:
     """Update generic stiffness parameters by the equation error (see module docstring).
 
     ``model`` is the initial model (or its discretisation); ``q0`` may replace its parameter
@@ -389,96 +522,102 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
     (n_dof, n_modes), when every DOF was measured, replaces the expansion.  With ``expand``,
     ``refinements`` re-expansions with the updated model follow the first solve (each
     re-solves the convex problem; the regularisation stays anchored at the initial model).
-    ``bilinear`` starts from the ``expand`` solution.  Never raises for a failed solve: the
-    result's ``success``/``status`` say so and ``ok`` is False.
+    ``bilinear`` starts from the ``expand`` solution.  ``update_mass`` adds the uniform
+    generic mass parameters (beam m11, m12, m14, m22 of eq. 17; bar β of eq. 2) with their
+    positive-definiteness conditions (``expand`` only).  Never raises for a failed solve:
+    the result's ``success``/``status`` say so and ``ok`` is False.
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r} (one of {', '.join(METHODS)})")
+    if update_mass and method != "expand":
+        raise ValueError("mass parameters are updated with method='expand' only")
     if regularisation is None:
         regularisation = default_regularisation(full_shapes is not None)
     disc = discretise(model) if isinstance(model, Model) else model
     par = parameterisation if isinstance(parameterisation, Parameterisation) else \
         parameterisation_for(disc.kind, parameterisation, disc.n_elements, disc.element_length)
     start = time.perf_counter()
-    pb = _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes)
+
+    def prepare(expansion_disc=None):
+        return _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes,
+                        expansion_disc, update_mass)
+
+    pb = prepare()
     notes = []
-    (success, status, info), (q_opt, phi_opt) = _solve_ipopt(pb, "expand", pb.q0, max_iter)
+    (success, status, info), (x_opt, phi_opt) = _solve_ipopt(pb, "expand", pb.x0, max_iter)
     for done in range(refinements if full_shapes is None else 0):
         if not success:
             break
-        pb = _prepare(disc, par, measured, noise, regularisation, margin, q0, None,
-                      expansion_params=par.element_parameters(q_opt))
-        (success, status, info), (q_new, phi_opt) = _solve_ipopt(pb, "expand", q_opt,
+        updated = _updated_discretisation(pb, x_opt)
+        pb = prepare(updated)
+        (success, status, info), (x_new, phi_opt) = _solve_ipopt(pb, "expand", x_opt,
                                                                  max_iter)
-        step = np.max(np.abs(q_new - q_opt) / pb.scale)
-        q_opt = q_new
+        step = np.max(np.abs(x_new - x_opt) / pb.x_scale)
+        x_opt = x_new
         info["refinements"] = done + 1
         if step < 1e-6:
             break
     if method == "bilinear":
         if not success:
             notes.append(f"the expand start did not converge ({status})")
-        (success, status, info), (q_opt, phi_opt) = _solve_ipopt(pb, method, q_opt, max_iter)
-    return _finish(pb, method, "ipopt", q_opt, phi_opt, status, success, info,
+        (success, status, info), (x_opt, phi_opt) = _solve_ipopt(pb, method, x_opt, max_iter)
+    return _finish(pb, method, "ipopt", x_opt, phi_opt, status, success, info,
                    time.perf_counter() - start, notes)
 
 
-def _solve_ipopt(pb: _Problem, method: str, q_start, max_iter: int):
-    """One IPOPT solve; returns ((success, status, stats), (q, free-DOF shapes))."""
-    n_q, n_free, m = pb.par.n_params, pb.phi0.shape[0], pb.omega.size
+def _solve_ipopt(pb: _Problem, method: str, x_start, max_iter: int):
+    """One IPOPT solve; returns ((success, status, stats), (x, free-DOF shapes))."""
+    n_x, n_free, m = pb.x0.size, pb.phi0.shape[0], pb.omega.size
     # -- decision variables (scaled to order one) -----------------------------------------
-    z_q = ca.SX.sym("z_q", n_q)
-    q = pb.scale * z_q
-    variables, start_values = [z_q], [np.asarray(q_start) / pb.scale]
+    z_x = ca.SX.sym("z_x", n_x)
+    x = pb.x_scale * z_x
+    variables, start_values = [z_x], [np.asarray(x_start) / pb.x_scale]
     # -- objective ------------------------------------------------------------------------
-    J = 0
     if method == "expand":
         B, b, _ = _expanded_least_squares(pb)
-        J = ca.sumsqr(ca.mtimes(_dm(B), z_q) + b) * (n_free * m * pb.eq_scale)
+        J = ca.sumsqr(ca.mtimes(_dm(B), z_x) + b)
     else:
         pat = pb.kmap.pattern
         K = ca.SX(ca.Sparsity(pat.shape[0], pat.shape[1], pat.indptr.tolist(),
                               pat.indices.tolist()),
-                  ca.mtimes(_dm(pb.kmap.S), q) + pb.kmap.extra)
+                  ca.mtimes(_dm(pb.kmap.S), x) + pb.kmap.extra)
         Mdm, Cdm = _dm(pb.M), _dm(pb.C)
         phi_scale = np.maximum(np.abs(pb.phi0).max(axis=1), 1e-12)
         z_phi = ca.SX.sym("z_phi", n_free, m)
         variables.append(ca.vec(z_phi))
         start_values.append((pb.phi0 / phi_scale[:, None]).ravel(order="F"))
-        misfit = 0
+        J, misfit = 0, 0
         for j in range(m):
             phi = phi_scale * z_phi[:, j]
             r = ca.mtimes(K, phi) - pb.omega[j] ** 2 * ca.mtimes(Mdm, phi)
             J += ca.sumsqr(pb.row_weights[:, j] * r)
             misfit += ca.sumsqr(ca.mtimes(Cdm, phi) - pb.y[:, j])
-    J = J / (n_free * m * pb.eq_scale)
-    J += pb.regularisation / n_q * ca.sum1(pb.param_weights * (z_q - pb.q0 / pb.scale) ** 2)
-    if method == "bilinear":
-        J += misfit / (max(pb.noise, 1e-6) ** 2 * pb.y.size)
+        J = J / (n_free * m * pb.eq_scale) + misfit / (max(pb.noise, 1e-6) ** 2 * pb.y.size)
+    J += pb.regularisation / n_x * ca.sum1(pb.x_weights * (z_x - pb.x0 / pb.x_scale) ** 2)
     # -- constraints ----------------------------------------------------------------------
-    g = _constraints(pb, q)
-    lbg, ubg = np.full(g.shape[0], pb.margin), np.full(g.shape[0], np.inf)
+    g, lbg = _constraints(pb, x)
+    ubg = np.full(lbg.size, np.inf)
     if method == "expand":
         A, b = _energy_balance(pb)
-        g = ca.vertcat(g, ca.mtimes(ca.DM(A), q) + b)
+        g = ca.vertcat(g, ca.mtimes(ca.DM(A), x) + b)
         lbg, ubg = np.concatenate([lbg, np.zeros(b.size)]), np.concatenate([ubg, np.zeros(b.size)])
     # -- solve ----------------------------------------------------------------------------
     solver = ca.nlpsol("equation_error", "ipopt", {"x": ca.vertcat(*variables), "f": J, "g": g},
                        {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
-                        "ipopt.max_iter": max_iter, "ipopt.tol": 1e-10,
-                        "ipopt.acceptable_tol": 1e-8})
+                        "ipopt.max_iter": max_iter, "ipopt.tol": 1e-8,
+                        "ipopt.acceptable_tol": 1e-6})
     try:
         sol = solver(x0=np.concatenate(start_values), lbg=lbg, ubg=ubg)
     except RuntimeError as exc:  # CasADi raises on evaluation errors
         raise GfeSolverError(f"IPOPT failed: {exc}") from exc
     stats = solver.stats()
     xs = np.array(sol["x"]).ravel()
-    q_opt = pb.scale * xs[:n_q]
+    x_opt = pb.x_scale * xs[:n_x]
     phi_opt = pb.phi0 if method == "expand" else \
-        xs[n_q:].reshape((n_free, m), order="F") * phi_scale[:, None]
+        xs[n_x:].reshape((n_free, m), order="F") * phi_scale[:, None]
     info = {k: stats.get(k) for k in ("return_status", "iter_count")}
     return ((bool(stats.get("success")), str(stats.get("return_status")), info),
-            (q_opt, phi_opt))
+            (x_opt, phi_opt))
 
 
 # -------------------------------------------------------------------------------------------
@@ -489,11 +628,12 @@ def _solve_ipopt(pb: _Problem, method: str, q_start, max_iter: int):
 def update_sdp(model: Model | Discretisation, measured: MeasuredModes, *,
                parameterisation: str | Parameterisation = "nodal",
                noise: float = DEFAULT_SHAPE_NOISE, regularisation: float | None = None,
-               margin: float = 1e-3, full_shapes=None, solver: str = "CLARABEL"
-               ) -> UpdateResult:
+               margin: float = 1e-3, full_shapes=None, solver: str = "CLARABEL",
+               update_mass: bool = False) -> UpdateResult:
     r"""The ``expand`` problem as a convex SDP: same objective, with every element stiffness
     semidefinite, :math:`P_e / k_0 \succeq m I` where :math:`K_e = H^T P_e H / L^3`
-    (bar: :math:`k_e \ge m k_0`).  Solved with cvxpy (Clarabel by default, or SCS)."""
+    (bar: :math:`k_e \ge m k_0`), and with ``update_mass`` the mass blocks positive definite
+    (linear matrix inequalities in m).  Solved with cvxpy (Clarabel by default, or SCS)."""
     import cvxpy as cp
 
     if regularisation is None:
@@ -502,20 +642,32 @@ def update_sdp(model: Model | Discretisation, measured: MeasuredModes, *,
     par = parameterisation if isinstance(parameterisation, Parameterisation) else \
         parameterisation_for(disc.kind, parameterisation, disc.n_elements, disc.element_length)
     start = time.perf_counter()
-    pb = _prepare(disc, par, measured, noise, regularisation, margin, None, full_shapes)
+    pb = _prepare(disc, par, measured, noise, regularisation, margin, None, full_shapes,
+                  None, update_mass)
     B, b, reg = _expanded_least_squares(pb)
-    z = cp.Variable(par.n_params)
-    z0 = pb.q0 / pb.scale
+    z = cp.Variable(pb.x0.size)
+    z0 = pb.x0 / pb.x_scale
     objective = cp.sum_squares(B @ z + b) + cp.sum_squares(cp.multiply(reg, z - z0))
-    p = (par.matrix @ sp.diags(pb.scale) / pb.k0) @ z
+    p = (par.matrix @ sp.diags(pb.scale) / pb.k0) @ z[:pb.n_q]
     n = par.n_elements
     if disc.kind == "bar":
         constraints = [p >= margin]
     else:
         constraints = [cp.bmat([[p[e], p[n + e]], [p[n + e], p[2 * n + e]]]) >> margin * np.eye(2)
                        for e in range(n)]
+    if pb.mmap is not None:
+        mass = z[pb.n_q:] * 0.1
+        if disc.kind == "bar":
+            constraints.append(mass[0] <= 0.25 - MASS_MARGIN)
+        else:  # eq. 17 is positive definite iff its two R-invariant 2x2 blocks are
+            m11, m12, m14, m22 = (mass[i] for i in range(4))
+            m24 = 1.0 / 6.0 - m11 / 2.0 + m12 + m14 - m22
+            eye = MASS_MARGIN * np.eye(2)
+            constraints += [cp.bmat([[0.5, m12 - m14], [m12 - m14, m22 - m24]]) >> eye,
+                            cp.bmat([[2 * m11 - 0.5, m12 + m14],
+                                     [m12 + m14, m22 + m24]]) >> eye]
     A, b_energy = _energy_balance(pb)
-    constraints.append((A @ sp.diags(pb.scale)) @ z + b_energy == 0)
+    constraints.append((A @ sp.diags(pb.x_scale)) @ z + b_energy == 0)
     problem = cp.Problem(cp.Minimize(objective), constraints)
     if not problem.is_dcp():
         raise GfeSolverError("the SDP variant is not DCP (a formulation bug)")
@@ -525,9 +677,9 @@ def update_sdp(model: Model | Discretisation, measured: MeasuredModes, *,
         raise GfeSolverError(f"cvxpy/{solver} failed: {exc}") from exc
     status = str(problem.status)
     success = status == cp.OPTIMAL
-    q = pb.scale * (np.asarray(z.value).ravel() if z.value is not None else z0)
+    x = pb.x_scale * (np.asarray(z.value).ravel() if z.value is not None else z0)
     stats = {"return_status": status, "solver": solver,
              "iter_count": problem.solver_stats.num_iters,
              "t_wall_total": problem.solver_stats.solve_time}
-    return _finish(pb, "expand", f"cvxpy-{solver.lower()}", q, pb.phi0, status, success, stats,
+    return _finish(pb, "expand", f"cvxpy-{solver.lower()}", x, pb.phi0, status, success, stats,
                    time.perf_counter() - start, [])

@@ -6,12 +6,13 @@ import pytest
 from gfe_opt import elements as el
 from gfe_opt.assembly import discretise
 from gfe_opt.measured import make_measured
+from gfe_opt.modal import discretisation_modes
 from gfe_opt.model import Effect
 from gfe_opt.parameterisation import beam_parameterisation
 from gfe_opt.synthetic import full_shapes_at_nodes, reference_with_rigidity, synthetic_measurement
 from gfe_opt.updating import update_generic, update_sdp
 
-from .conftest import make_model
+from .conftest import STEEL_BAR, make_model
 
 
 def _all_dof_data(model, rigidity, n_modes, ratio=8):
@@ -120,3 +121,47 @@ def test_failed_solve_is_reported_not_hidden():
     assert not result.success and not result.ok
     assert "Maximum_Iterations" in result.status
     assert any("must not be used" in n for n in result.notes)
+
+
+def _exact_bar_modes(bar, n_modes):
+    """Closed-form fixed-free bar modes, u at every node (all DOFs of a bar)."""
+    n = np.arange(1, n_modes + 1)
+    k = (2 * n - 1) * np.pi / (2 * bar.length)
+    freqs = k * np.sqrt(bar.E / bar.rho) / (2 * np.pi)
+    shapes = np.sin(np.outer(bar.nodes, k))
+    return make_measured(bar.nodes[1:], "u", freqs, shapes[1:], "closed form"), shapes
+
+
+@pytest.mark.parametrize("start", ["lumped", "consistent"])
+def test_bar_mass_update_finds_minimum_error_beta(start):
+    # eq. 2: beta = 1/12 has the smallest discretisation error; updating beta (and EA) from
+    # closed-form modes must find it, from below (lumped, 0) and from above (consistent, 1/6)
+    bar = make_model(STEEL_BAR, elements=40, mass=start)
+    measured, shapes = _exact_bar_modes(bar, 3)
+    result = update_generic(bar, measured, parameterisation="nodal", full_shapes=shapes,
+                            noise=0.0, update_mass=True)
+    assert result.ok, result.summary()
+    assert abs(result.mass_parameters["beta"] - 1 / 12) < 2e-3
+    check = update_sdp(bar, measured, parameterisation="nodal", full_shapes=shapes, noise=0.0,
+                       update_mass=True)
+    assert abs(check.mass_parameters["beta"] - result.mass_parameters["beta"]) < 1e-4
+
+
+def test_beam_mass_update_stays_positive_definite_and_matches_sdp():
+    beam = make_model(elements=12)
+    k = np.arange(1, 4) * np.pi / beam.length
+    freqs = k**2 * np.sqrt(beam.bending_rigidity / beam.mass_per_length) / (2 * np.pi)
+    shapes = np.zeros((beam.n_dof, 3))
+    shapes[0::2] = np.sin(np.outer(beam.nodes, k))
+    shapes[1::2] = np.cos(np.outer(beam.nodes, k)) * k
+    measured = make_measured(beam.nodes[1:-1], "w", freqs, shapes[2:-2:2], "closed form")
+    a = update_generic(beam, measured, full_shapes=shapes, noise=0.0, update_mass=True)
+    b = update_sdp(beam, measured, full_shapes=shapes, noise=0.0, update_mass=True)
+    assert a.ok and b.ok
+    assert np.allclose(list(a.mass_parameters.values()), list(b.mass_parameters.values()),
+                       atol=1e-6)
+    M = el.symmetric_beam_mass(**a.mass_parameters)
+    assert np.linalg.eigvalsh(M).min() > 0
+    before = discretisation_modes(discretise(beam), 3).frequencies_hz
+    after = discretisation_modes(a.discretisation, 3).frequencies_hz
+    assert np.max(np.abs(after / freqs - 1)) < 1e-3 * np.max(np.abs(before / freqs - 1))
