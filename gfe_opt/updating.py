@@ -259,6 +259,8 @@ class UpdateResult:
     scale: np.ndarray | None = None
     mass_parameters: dict | None = None
     mass_parameters_initial: dict | None = None
+    k0: float = 1.0
+    margin: float = 0.0
 
     @property
     def ok(self) -> bool:
@@ -446,7 +448,7 @@ def _finish(pb, method, solver, x, phi, status, success, stats, seconds, notes):
                         objective_initial=J0, residual_per_mode=per_mode,
                         residual_per_mode_initial=per_mode0, status=status, success=success,
                         stats=stats, violations=violations, seconds=seconds, shapes=shapes,
-                        notes=notes, scale=pb.scale,
+                        notes=notes, scale=pb.scale, k0=pb.k0, margin=pb.margin,
                         mass_parameters=None if pb.mmap is None else
                         dict(zip(pb.mmap.names, x[pb.n_q:].tolist())),
                         mass_parameters_initial=None if pb.mmap is None else
@@ -683,3 +685,33 @@ def update_sdp(model: Model | Discretisation, measured: MeasuredModes, *,
              "t_wall_total": problem.solver_stats.solve_time}
     return _finish(pb, "expand", f"cvxpy-{solver.lower()}", x, pb.phi0, status, success, stats,
                    time.perf_counter() - start, [])
+
+
+
+def active_constraints(result: UpdateResult, tol: float = 1e-6) -> list[int]:
+    """Elements on a bound of the solver's own constraints: IPOPT k_ww, k_θθ or
+    k_ww k_θθ - k_wθ² at the margin; SDP λ_min(P_e / k0) at the margin (bar: k / k0)."""
+    p = {k: np.asarray(v) / result.k0 for k, v in result.element_parameters.items()}
+    if "k" in p:
+        slack = p["k"] - result.margin
+    elif result.solver.startswith("cvxpy"):
+        P = np.stack([np.stack([p["k_ww"], p["k_wt"]], -1),
+                      np.stack([p["k_wt"], p["k_tt"]], -1)], -2)
+        slack = np.linalg.eigvalsh(P)[:, 0] - result.margin
+    else:
+        slack = np.min([p["k_ww"], p["k_tt"], p["k_ww"] * p["k_tt"] - p["k_wt"] ** 2],
+                       axis=0) - result.margin
+    return np.flatnonzero(slack <= tol).tolist()
+
+
+def cross_check(ipopt: UpdateResult, sdp: UpdateResult, tol: float = 1e-4) -> dict:
+    """Compare an IPOPT and an SDP solution of the same problem: relative parameter and
+    objective differences, constraint activity, and whether they agree within ``tol``."""
+    scale = np.maximum(np.abs(ipopt.q), np.abs(ipopt.scale))
+    param = float(np.max(np.abs(ipopt.q - sdp.q) / scale))
+    objective = float(abs(ipopt.objective - sdp.objective) / max(abs(sdp.objective), 1e-300))
+    out = {"parameter_difference": param, "objective_difference": objective,
+           "active_ipopt": active_constraints(ipopt), "active_sdp": active_constraints(sdp),
+           "both_ok": ipopt.ok and sdp.ok}
+    out["agree"] = bool(out["both_ok"] and param <= tol and objective <= tol)
+    return out

@@ -26,10 +26,11 @@ def test_paper_case_study(tmp_path):
 
 def test_compare_solvers(tmp_path):
     out = _run("compare_solvers.py", cwd=tmp_path)
-    rows = json.loads(out[out.index("["):])
+    rows = json.loads(out[out.index("\n[") + 1:])
     assert len(rows) == 9
     taper = [r for r in rows if r["problem"].startswith("tapered")]
     assert all(r["ok"] for r in taper)
+    assert out.count("agree=True") == 3  # IPOPT and the SDP on the same convex step
 
 
 def test_bench_eigen_accuracy(tmp_path):

@@ -10,7 +10,7 @@ from gfe_opt.modal import discretisation_modes
 from gfe_opt.model import Effect
 from gfe_opt.parameterisation import beam_parameterisation
 from gfe_opt.synthetic import full_shapes_at_nodes, reference_with_rigidity, synthetic_measurement
-from gfe_opt.updating import update_generic, update_sdp
+from gfe_opt.updating import cross_check, update_generic, update_sdp
 
 from .conftest import STEEL_BAR, make_model
 
@@ -97,9 +97,18 @@ def test_ipopt_and_sdp_agree_on_a_convex_instance():
     measured, shapes = _all_dof_data(model, _dip(model), 3)
     a = update_generic(model, measured, full_shapes=shapes, noise=0.0)
     b = update_sdp(model, measured, full_shapes=shapes, noise=0.0)
-    assert a.ok and b.ok
-    assert np.isclose(a.objective, b.objective, rtol=1e-6)
-    assert np.max(np.abs(a.q - b.q)) < 1e-5 * np.max(np.abs(a.q))
+    check = cross_check(a, b, tol=1e-5)
+    assert check["agree"], check
+    assert check["active_ipopt"] == check["active_sdp"] == []
+
+
+def test_cross_check_reports_disagreement():
+    model = make_model(elements=20)
+    measured, shapes = _all_dof_data(model, _dip(model), 3)
+    a = update_generic(model, measured, full_shapes=shapes, noise=0.0)
+    b = update_sdp(model, measured, full_shapes=shapes, noise=0.0, regularisation=1.0)
+    check = cross_check(a, b)
+    assert not check["agree"] and check["parameter_difference"] > 1e-3
 
 
 def test_infeasible_start_is_handled():
