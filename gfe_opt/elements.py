@@ -20,6 +20,7 @@ Degrees of freedom follow the paper:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Callable, Mapping
 
 import numpy as np
@@ -405,6 +406,11 @@ def linear(xi):
     return np.stack([1 - xi, xi], axis=-1)
 
 
+@lru_cache(maxsize=8)
+def _gauss_legendre(order: int):
+    return np.polynomial.legendre.leggauss(order)
+
+
 def element_quadrature(x0, x1, breakpoints=(), refine_scale=None, order=6):
     """Composite Gauss–Legendre points and weights on [x0, x1] (physical coordinates).
 
@@ -422,7 +428,7 @@ def element_quadrature(x0, x1, breakpoints=(), refine_scale=None, order=6):
                 if x0 < c < x1:
                     cuts.add(c)
     cuts = np.array(sorted(cuts))
-    g, w = np.polynomial.legendre.leggauss(order)
+    g, w = _gauss_legendre(order)
     a, b = cuts[:-1, None], cuts[1:, None]
     x = 0.5 * (b - a) * g + 0.5 * (a + b)
     return x.ravel(), (0.5 * (b - a) * w).ravel()

@@ -14,12 +14,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .assembly import Discretisation, discretise
 from .errors import GfeSolverError
 from .model import Model
+
+#: Up to this many free DOFs a dense generalised eigensolver is faster than shift-invert.
+DENSE_LIMIT = 400
 
 
 @dataclass(frozen=True)
@@ -62,11 +66,8 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     Ms = (D @ Mf @ D).tocsc()
     sigma = -eigenvalue_scale
     try:
-        if len(free) <= 60:
-            import scipy.linalg as sla
-
-            lam, vec = sla.eigh(Ks.toarray(), Ms.toarray())
-            lam, vec = lam[:n_modes], vec[:, :n_modes]
+        if len(free) <= DENSE_LIMIT:
+            lam, vec = sla.eigh(Ks.toarray(), Ms.toarray(), subset_by_index=[0, n_modes - 1])
         else:
             lu = spla.splu((Ks - sigma * Ms).tocsc())
             op = spla.LinearOperator(Ks.shape, matvec=lu.solve, dtype=float)
