@@ -77,9 +77,10 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
         raise GfeSolverError(f"eigen solve failed: {exc}") from exc
     order = np.argsort(lam)
     lam, vec = lam[order], vec[:, order]
-    # rigid-body eigenvalues come out as roundoff of size eps * ||K||
-    zero = max(1e-9 * eigenvalue_scale, 1e-11 * float(np.max(Ks.diagonal())))
-    lam = np.where(np.abs(lam) < zero, 0.0, lam)
+    # rigid-body eigenvalues come out as roundoff (either sign): clamp to zero what is tiny
+    # next to the largest eigenvalue computed
+    roundoff = max(1e-9 * eigenvalue_scale, 1e-8 * float(np.max(np.abs(lam))))
+    lam = np.where(np.abs(lam) < roundoff, 0.0, lam)
     if np.any(lam < 0):
         raise GfeSolverError(f"eigen solve returned negative eigenvalues {lam[lam < 0]}: "
                              "stiffness is not positive semidefinite")
