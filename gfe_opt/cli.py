@@ -14,8 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from .correlation import DEFAULT_MAC_THRESHOLD, DEFAULT_SHAPE_NOISE, Comparison, compare
+from .diagnosis import CANDIDATES, DEFAULT_FREQ_NOISE
+from .diagnosis import DEFAULT_SHAPE_NOISE as DEFAULT_DIAG_SHAPE_NOISE
 from .errors import GfeInputError, GfeSolverError
-from .measured import load_measured
+from .measured import check_output_path, load_measured
 from .model import load_model
 
 SPARK = " ▁▂▃▄▅▆▇█"
@@ -47,6 +49,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--noise", type=_fraction, default=DEFAULT_SHAPE_NOISE,
                    help="relative shape noise that regularises the expansion "
                         "(default %(default)s)")
+
+    def noise_options(p):
+        p.add_argument("--freq-noise", type=_fraction, default=DEFAULT_FREQ_NOISE,
+                       help="relative frequency noise σ_f (default %(default)s)")
+        p.add_argument("--shape-noise", type=_fraction, default=DEFAULT_DIAG_SHAPE_NOISE,
+                       help="shape noise σ_s relative to each mode's largest amplitude "
+                            "(default %(default)s)")
+
+    g = sub.add_parser("diagnose", help="rank the physical effects that explain the error")
+    g.add_argument("model", help="model file (.toml)")
+    g.add_argument("measured", help="measured modes (.json, .csv, .uff, .unv)")
+    g.add_argument("--json", action="store_true", help="print the result as JSON")
+    g.add_argument("--candidates", default=",".join(CANDIDATES),
+                   help="comma-separated effects to try (default: all)")
+    noise_options(g)
+
+    u = sub.add_parser("update", help="add effects, fit their parameters, see the error fall")
+    u.add_argument("model", help="model file (.toml)")
+    u.add_argument("measured", help="measured modes (.json, .csv, .uff, .unv)")
+    u.add_argument("--add", action="append", required=True, metavar="EFFECT",
+                   help="effect to add, e.g. crack or crack:position=0.2 (repeatable)")
+    u.add_argument("--out", help="write the updated model (with its [[effects]]) here")
+    u.add_argument("--force", action="store_true", help="overwrite an existing --out file")
+    u.add_argument("--json", action="store_true", help="print the result as JSON")
+    noise_options(u)
 
     d = sub.add_parser("demo", help="the whole story on a synthetic cracked beam")
     d.add_argument("--out", default="gfe-opt-demo",
@@ -99,6 +126,97 @@ def cmd_compare(args) -> int:
     return 0
 
 
+def _progress(enabled: bool):
+    """A one-line progress report on stderr when it is a terminal."""
+    if not (enabled and sys.stderr.isatty()):
+        return None
+
+    def report(done, total, name):
+        end = "\n" if done == total else ""
+        print(f"\rfitting candidate effects: {done}/{total} {name:<16}", end=end,
+              file=sys.stderr, flush=True)
+
+    return report
+
+
+def _format_params(params: dict) -> str:
+    return ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
+                     for k, v in params.items())
+
+
+def format_diagnosis(result, model) -> str:
+    """Readable diagnosis: ranking, verdict, and what the generic update's equations say."""
+    b = result.baseline
+    lines = [f"baseline: frequency error {b.freq_error_rms_pct:.3f} % rms, mean MAC "
+             f"{b.mac_mean:.4f}", "",
+             f"{'rank':>4}  {'effect':<15} {'f err %':>8} {'MAC':>7}  {'significant':<11} "
+             "parameters"]
+    for i, f in enumerate(result.fits, 1):
+        lines.append(f"{i:>4}  {f.effect:<15} {f.misfit.freq_error_rms_pct:8.3f} "
+                     f"{f.misfit.mac_mean:7.4f}  {'yes' if f.significant else 'no':<11} "
+                     f"{_format_params(f.parameters)}")
+    best = result.best
+    lines.append("")
+    if best is None:
+        lines.append("no candidate explains significantly more than the measurement noise")
+    else:
+        lines.append(f"most likely missing: {best.effect} ({_format_params(best.parameters)}):"
+                     f" frequency error {b.freq_error_rms_pct:.3f} % -> "
+                     f"{best.misfit.freq_error_rms_pct:.3f} %")
+    lines += [f"the generic-element update says: {t}" for t in result.realisation]
+    lines.append(f"({result.seconds:.1f} s)")
+    return "\n".join(lines)
+
+
+def cmd_diagnose(args) -> int:
+    from .diagnosis import diagnose
+
+    model = load_model(args.model)
+    measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
+    candidates = [c.strip() for c in args.candidates.split(",") if c.strip()]
+    unknown = [c for c in candidates if c not in CANDIDATES]
+    if unknown:
+        raise GfeInputError("--candidates", unknown[0], "unknown effect (known: "
+                            f"{', '.join(CANDIDATES)})")
+    result = diagnose(model, measured, candidates=candidates, freq_noise=args.freq_noise,
+                      shape_noise=args.shape_noise, progress=_progress(not args.json),
+                      realise=True)
+    if args.json:
+        print(json.dumps(result.to_json(), indent=1))
+    else:
+        print(format_diagnosis(result, model))
+    return 0
+
+
+def cmd_update(args) -> int:
+    from .diagnosis import parse_effect, update
+    from .model import save_model
+
+    model = load_model(args.model)
+    measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
+    effects = [parse_effect(a, model) for a in args.add]
+    if args.out:  # refuse before the work, not after
+        check_output_path(args.out, args.force, (args.model, args.measured))
+    outcome = update(model, measured, effects, freq_noise=args.freq_noise,
+                     shape_noise=args.shape_noise)
+    if args.out:
+        save_model(outcome.model, args.out, force=args.force,
+                   protect=(args.model, args.measured))
+    if args.json:
+        print(json.dumps(outcome.to_json(), indent=1))
+        return 0
+    print(f"before: frequency error {outcome.before.freq_error_rms_pct:.3f} % rms, "
+          f"mean MAC {outcome.before.mac_mean:.4f}")
+    for e in outcome.model.effects:
+        print(f"  fitted {e.name}: {_format_params(e.parameters)}")
+    print(f"after:  frequency error {outcome.after.freq_error_rms_pct:.3f} % rms, "
+          f"mean MAC {outcome.after.mac_mean:.4f}")
+    if args.out:
+        print(f"updated model written to {args.out}; continue with: gfe-opt diagnose "
+              f"{args.out} {args.measured}")
+    return 0
+
+
 def cmd_demo(args) -> int:
     from .demo import run_demo
 
@@ -110,7 +228,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     np.seterr(all="ignore")
     try:
-        return {"compare": cmd_compare, "demo": cmd_demo}[args.command](args)
+        return {"compare": cmd_compare, "diagnose": cmd_diagnose, "update": cmd_update,
+                "demo": cmd_demo}[args.command](args)
     except GfeInputError as exc:
         print(f"gfe-opt: error: {exc}", file=sys.stderr)
         return 2

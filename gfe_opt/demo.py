@@ -1,15 +1,16 @@
-"""``gfe-opt demo``: the story on a synthetic cracked beam, told step by step."""
+"""``gfe-opt demo``: the whole story on a synthetic cracked beam, told step by step."""
 
 from __future__ import annotations
 
 import shutil
 from pathlib import Path
 
-from .cli import format_comparison
+from .cli import _format_params, format_comparison, format_diagnosis
 from .correlation import compare
+from .diagnosis import diagnose, update
 from .errors import GfeInputError
 from .measured import save_measured
-from .model import Effect, load_model
+from .model import Effect, load_model, save_model
 from .problems import problem_file
 from .synthetic import interior_sensors, synthetic_measurement
 
@@ -17,9 +18,14 @@ from .synthetic import interior_sensors, synthetic_measurement
 DEMO_CRACK = {"position": 0.19, "depth_ratio": 0.5}
 
 
+def _indent(text: str) -> str:
+    return "   " + text.replace("\n", "\n   ")
+
+
 def run_demo(out: Path, force: bool = False) -> int:
     model_path, measured_path = out / "model.toml", out / "measured.json"
-    existing = [p for p in (model_path, measured_path) if p.exists()]
+    updated_path = out / "updated.toml"
+    existing = [p for p in (model_path, measured_path, updated_path) if p.exists()]
     if existing and not force:
         raise GfeInputError(str(existing[0]), None,
                             "exists already; pass --force to overwrite the demo's files")
@@ -36,14 +42,40 @@ def run_demo(out: Path, force: bool = False) -> int:
                                      seed=2002)
     save_measured(measured, measured_path)
     print(f"2. The test ({measured_path}): 5 modes at 45 accelerometers, simulated with an "
-          "independent fine model\n   of the real beam, which has a crack the model lacks "
+          "independent fine model\n   of the real beam, which has something the model lacks "
           "(0.3 % shape noise, 0.05 % frequency noise).")
-    print("3. Compare the model with the test and see where it fails:\n")
+    print("\n3. Compare: paired modes, and where along the beam the model fails.\n")
     result = compare(model, measured)
-    print("   " + format_comparison(result, model.length).replace("\n", "\n   "))
-    places = result.failure_places()
-    if places:
-        print(f"\n   The hidden crack is at x = {DEMO_CRACK['position']} m; the residual force "
-              f"points to x = {places[0][0]:.3f} m.")
-    print(f"\nReproduce step 3 with:\n  gfe-opt compare {model_path} {measured_path}")
+    print(_indent(format_comparison(result, model.length)))
+    print("\n4. Diagnose: each candidate physical effect is fitted (IPOPT) and ranked by how "
+          "much of\n   the error it explains; 'significant' means beyond the measurement "
+          "noise.\n")
+    diagnosis = diagnose(model, measured, realise=True)
+    print(_indent(format_diagnosis(diagnosis, model)))
+    best = diagnosis.best
+    if best is None:
+        print("\nNothing significant to add.")
+        return 0
+    print(f"\n5. Add it: update --add {best.effect} fits its parameters, starting from the "
+          "diagnosis.\n")
+    outcome = update(model, measured, [best.effect])
+    save_model(outcome.model, updated_path, force=True, protect=(model_path, measured_path))
+    for e in outcome.model.effects:
+        print(f"   fitted {e.name}: {_format_params(e.parameters)}")
+    print(f"   frequency error {outcome.before.freq_error_rms_pct:.3f} % -> "
+          f"{outcome.after.freq_error_rms_pct:.3f} % (noise 0.05 %), mean MAC "
+          f"{outcome.before.mac_mean:.4f} -> {outcome.after.mac_mean:.4f}")
+    print(f"   the hidden truth was: crack at x = {DEMO_CRACK['position']} m, "
+          f"a/d = {DEMO_CRACK['depth_ratio']}")
+    print("\n6. Check: diagnose the updated model; nothing significant should be left.\n")
+    again = diagnose(outcome.model, measured)
+    left = again.best
+    print("   nothing significant is left" if left is None else
+          f"   still significant: {left.effect} ({_format_params(left.parameters)})")
+    print(f"\nFiles in {out}/. Reproduce with:\n"
+          f"  gfe-opt compare {model_path} {measured_path}\n"
+          f"  gfe-opt diagnose {model_path} {measured_path}\n"
+          f"  gfe-opt update {model_path} {measured_path} --add {best.effect} "
+          f"--out {updated_path} --force\n"
+          f"  gfe-opt diagnose {updated_path} {measured_path}")
     return 0

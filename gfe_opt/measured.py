@@ -263,6 +263,17 @@ def atomic_write(path, write) -> None:
             tmp.unlink()
 
 
+def check_output_path(out, force: bool, inputs=()) -> None:
+    """Refuse an output path that is one of ``inputs``, or that exists without ``force``."""
+    out = Path(out)
+    for p in inputs:
+        if Path(p).resolve() == out.resolve():
+            raise GfeInputError(str(out), None, "would overwrite an input file; choose "
+                                "another output path")
+    if out.exists() and not force:
+        raise GfeInputError(str(out), None, "exists already; pass --force to overwrite it")
+
+
 def measured_to_dict(m: MeasuredModes) -> dict:
     """The JSON form of measured modes."""
     return {"sensors": {"x": [float(v) for v in m.x], "dof": m.dof},

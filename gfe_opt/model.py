@@ -326,3 +326,34 @@ def _no_unknown(tbl, known, where, prefix):
             close = difflib.get_close_matches(key, sorted(known), n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise GfeInputError(where, prefix + key, f"unknown key{hint}")
+
+
+def model_to_dict(model: Model) -> dict:
+    """The TOML mapping of a model (inverse of :func:`model_from_dict`)."""
+    data = {"name": model.name, "kind": model.kind, "length": model.length,
+            "elements": model.elements}
+    if model.mass_model != "consistent":
+        data["mass"] = model.mass_model
+    data["material"] = {"E": model.E, "rho": model.rho, "nu": model.nu}
+    if model.breadth is not None and model.depth is not None:
+        data["section"] = {"shape": "rectangle", "b": model.breadth, "h": model.depth}
+    else:
+        data["section"] = {"A": model.area, "I": model.inertia}
+        if model.depth is not None:
+            data["section"]["h"] = model.depth
+    data["supports"] = {"left": model.supports[0], "right": model.supports[1]}
+    if model.effects:
+        data["effects"] = [{"effect": e.name, **e.parameters} for e in model.effects]
+    return data
+
+
+def save_model(model: Model, path, *, force: bool = False, protect=()) -> None:
+    """Write ``model`` as TOML atomically.  Refuses to overwrite any path in ``protect``
+    (e.g. the input) and, unless ``force``, any existing file."""
+    import tomli_w
+
+    from .measured import atomic_write, check_output_path
+
+    check_output_path(path, force, protect)
+    text = tomli_w.dumps(model_to_dict(model))
+    atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"))

@@ -141,12 +141,9 @@ class Realisation:
     mass_ratio: float    # m / m0, from the coefficient of the acceleration
 
     def describe(self) -> str:
-        text = f"near x = {self.x:.3f} m: (k(x) w'')''"
-        if self.tension:
-            text += f" {'-' if self.tension > 0 else '+'} {abs(self.tension):.3g} w''"
-        if self.foundation:
-            text += f" + {self.foundation:.3g} w"
-        text += f" + m ẅ = 0 with k = {self.k_ratio:.2f} k0"
+        """The local reading; uniform terms (tension, foundation) are read along the whole
+        beam by :func:`summarise`, since one node's w'' and w terms also carry k''."""
+        text = f"near x = {self.x:.3f} m: (k(x) w'')'' + m ẅ = 0 with k = {self.k_ratio:.2f} k0"
         if abs(self.mass_ratio - 1) > 1e-3:
             text += f", m = {self.mass_ratio:.2f} m0"
         return text
@@ -221,8 +218,8 @@ def summarise(realisations: list[Realisation]) -> list[str]:
     local ones by their extreme node)."""
     k = np.array([r.k_ratio for r in realisations])
     m = np.array([r.mass_ratio for r in realisations])
-    tension = np.median([r.tension for r in realisations])
-    foundation = np.median([r.foundation for r in realisations])
+    tension = _uniform([r.tension for r in realisations])
+    foundation = _uniform([r.foundation for r in realisations])
     lines = []
     if abs(np.median(k) - 1) > 5e-3:
         lines.append(f"uniform bending stiffness {np.median(k):.3f} k0 (a material change)")
@@ -239,3 +236,14 @@ def summarise(realisations: list[Realisation]) -> list[str]:
         lines.append(f"local mass {m[j]:.2f} m0 near x = {realisations[j].x:.3f} m "
                      "(attached mass)")
     return lines
+
+
+def _uniform(values) -> float:
+    """The median of a term that is present along the whole beam with one sign and a small
+    spread (80 % of the nodes, interquartile range below half the median), else 0."""
+    v = np.asarray(values, float)
+    med = float(np.median(v))
+    if med == 0.0 or np.mean(np.sign(v) == np.sign(med)) < 0.8:
+        return 0.0
+    q1, q3 = np.percentile(v, [25, 75])
+    return med if (q3 - q1) < 0.5 * abs(med) else 0.0

@@ -16,7 +16,7 @@ from . import elements as el
 from .assembly import cracked_element_stiffness, discretise
 from .measured import MeasuredModes, make_measured, sensor_matrix
 from .modal import discretisation_modes
-from .model import Model
+from .model import Effect, Model
 
 
 def reference_discretisation(truth: Model, elements: int):
@@ -80,3 +80,42 @@ def synthetic_measurement(truth: Model, n_modes: int, sensors, *, shape_noise=0.
 def interior_sensors(length: float, count: int) -> np.ndarray:
     """``count`` equally spaced sensors strictly inside (0, length)."""
     return np.linspace(0.0, length, count + 2)[1:-1]
+
+
+def closed_form_measurement(model: Model, effect: Effect | None, n_modes: int, sensors, *,
+                            shape_noise=0.0, freq_noise=0.0, seed=0) -> MeasuredModes:
+    """Measured modes of a *simply supported* uniform beam from closed forms (shapes
+    sin(nπx/L) at the sensors), with ``effect`` one of ``material``, ``axial_load``
+    (ω² = (EI α⁴ + T α²)/ρA), ``foundation`` (ω² = (EI α⁴ + k_f)/ρA) or ``shear``
+    (Timoshenko with rotary inertia: the lower root of the 2x2 determinant), α = nπ/L."""
+    if model.kind != "beam" or model.supports != ("pinned", "pinned"):
+        raise ValueError("closed forms are for simply supported beams")
+    EI, rho_a, length = model.bending_rigidity, model.mass_per_length, model.length
+    n = np.arange(1, n_modes + 1)
+    alpha = n * np.pi / length
+    name = effect.name if effect else None
+    p = effect.parameters if effect else {}
+    if name == "material":
+        omega2 = p["E"] * model.inertia * alpha**4 / rho_a
+    elif name == "axial_load":
+        omega2 = (EI * alpha**4 + p["tension"] * alpha**2) / rho_a
+    elif name == "foundation":
+        omega2 = (EI * alpha**4 + p["stiffness"]) / rho_a
+    elif name == "shear":
+        kga, rho_i = p["shear_rigidity"], model.rho * model.inertia
+        # det [[kGA a² - ρA ω², -kGA a], [-kGA a, EI a² + kGA - ρI ω²]] = 0, quadratic in ω²
+        a2 = rho_a * rho_i
+        a1 = -(rho_a * (EI * alpha**2 + kga) + rho_i * kga * alpha**2)
+        a0 = kga * alpha**2 * (EI * alpha**2 + kga) - (kga * alpha) ** 2
+        omega2 = (-a1 - np.sqrt(a1**2 - 4 * a2 * a0)) / (2 * a2)
+    elif name is None:
+        omega2 = EI * alpha**4 / rho_a
+    else:
+        raise ValueError(f"no closed form for {name!r}")
+    sensors = np.asarray(sensors, float)
+    shapes = np.sin(np.outer(sensors, alpha))
+    rng = np.random.default_rng(seed)
+    shapes = shapes + shape_noise * np.max(np.abs(shapes), axis=0) * rng.standard_normal(
+        shapes.shape)
+    freqs = np.sqrt(omega2) / (2 * np.pi) * (1 + freq_noise * rng.standard_normal(n_modes))
+    return make_measured(sensors, "w", freqs, shapes, f"closed-form({name})")
