@@ -63,12 +63,60 @@ def test_missing_file_exits_2(files, capsys):
     assert "no such file" in capsys.readouterr().err
 
 
-def test_demo_runs_and_refuses_to_overwrite(tmp_path, capsys):
+def test_demo_tells_the_whole_story_and_refuses_to_overwrite(tmp_path, capsys):
     out = tmp_path / "demo"
     assert main(["demo", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     assert (out / "model.toml").exists() and (out / "measured.json").exists()
     assert "the model fails most near x = 0.1" in text
+    assert "most likely missing: crack" in text
+    assert "nothing significant is left" in text
+    updated = load_model(out / "updated.toml")
+    assert [e.name for e in updated.effects] == ["crack"]
+    assert abs(updated.effects[0].parameters["position"] - 0.19) < 0.015
     assert main(["demo", "--out", str(out)]) == 2
     assert "--force" in capsys.readouterr().err
-    assert main(["demo", "--out", str(out), "--force"]) == 0
+
+
+def test_diagnose_json_contract(files, capsys):
+    model, measured, _ = files
+    assert main(["diagnose", str(model), str(measured), "--json",
+                 "--candidates", "material,crack"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert set(data) == {"baseline", "effects"}
+    assert set(data["baseline"]) == {"freq_error_rms_pct", "mac_mean"}
+    assert [e["effect"] for e in data["effects"]][0] == "crack"
+    for entry in data["effects"]:
+        assert set(entry) == {"effect", "parameters", "freq_error_rms_pct", "mac_mean",
+                              "significant"}
+    assert abs(data["effects"][0]["parameters"]["position"] - 0.4) < 0.015
+
+
+def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_path):
+    model, measured, _ = files
+    out = tmp_path / "new.toml"
+    assert main(["update", str(model), str(measured), "--add", "crack:position=0.39",
+                 "--out", str(out), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert set(data) == {"before", "after", "effects"}
+    assert set(data["before"]) == set(data["after"]) == {"freq_error_rms_pct", "mac_mean"}
+    assert data["after"]["freq_error_rms_pct"] < 0.1 * data["before"]["freq_error_rms_pct"]
+    assert data["effects"][0]["effect"] == "crack"
+    assert [e.name for e in load_model(out).effects] == ["crack"]
+    # --out never overwrites its input, nor an existing file without --force
+    assert main(["update", str(model), str(measured), "--add", "crack", "--out",
+                 str(model)]) == 2
+    assert "input" in capsys.readouterr().err
+    assert main(["update", str(model), str(measured), "--add", "crack", "--out",
+                 str(out)]) == 2
+    assert "--force" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("add,match", [("rust", "unknown effect 'rust'"),
+                                       ("crack:depth=0.2", "expected key=value"),
+                                       ("crack:position=abc", "must be a number")])
+def test_bad_add_exits_2(files, capsys, add, match):
+    model, measured, _ = files
+    assert main(["update", str(model), str(measured), "--add", add]) == 2
+    err = capsys.readouterr().err
+    assert match in err and err.count("\n") == 1

@@ -1,0 +1,119 @@
+"""Physical realisation: the paper's Taylor expansions, and numeric nodal equations."""
+
+import numpy as np
+import sympy
+
+from gfe_opt.assembly import discretise
+from gfe_opt.model import Effect
+from gfe_opt.realisation import (
+    L,
+    bar_row,
+    beam_row,
+    k,
+    m,
+    nodal_equations,
+    realise,
+    summarise,
+    t,
+    taylor_expand_row,
+    u,
+    x,
+)
+
+from .conftest import make_model
+
+D = sympy.diff
+U = u(x, t)
+ACC = D(U, t, 2)
+
+
+def test_eq5_general_two_element_bar_row():
+    # eq. 5 with constant k^j, k^{j+1}, m^j, m^{j+1} (no eq. 7): the L^n coefficient of u
+    kj, kj1, mj, mj1, beta = sympy.symbols("k_j k_j1 m_j m_j1 beta")
+    stencil = [(-kj, -1, U), (kj + kj1, 0, U), (-kj1, 1, U),
+               (L**2 * mj * beta, -1, ACC), (L**2 * (mj + mj1) * (sympy.Rational(1, 2) - beta),
+                                              0, ACC), (L**2 * mj1 * beta, 1, ACC)]
+    series = taylor_expand_row(stencil, 4)
+    for n in (1, 3, 4):
+        expected = -(kj1 + (-1) ** n * kj) / sympy.factorial(n) * D(U, x, n)
+        if n >= 3:  # the mass sum of eq. 5 starts at L^3 (its n = 1)
+            expected += beta * (mj1 + (-1) ** (n - 2) * mj) / sympy.factorial(n - 2) * \
+                D(ACC, x, n - 2)
+        assert sympy.simplify(series[n] - expected) == 0
+    # eq. 6: the first-order term is the sum of internal forces
+    assert sympy.simplify(series[1] + (kj1 - kj) * D(U, x)) == 0
+    assert sympy.simplify(series[2] - (-(kj1 + kj) / 2 * D(U, x, 2)
+                                       + (mj + mj1) / 2 * ACC)) == 0
+
+
+def test_eq8_orders_with_nodal_properties():
+    c = sympy.symbols("c1:5")
+    series = bar_row(c=c, order=3)
+    assert series[0] == 0 and series[1] == 0  # eq. 8, L^1: satisfied automatically
+    expected2 = -(c[0] + c[1]) * D(k(x) * D(U, x), x) + (c[2] + c[3]) * m(x) * ACC
+    assert sympy.simplify(series[2] - expected2) == 0
+    expected3 = (sympy.Rational(1, 2) * (c[0] - c[1]) * D(D(k(x), x) * D(U, x), x)
+                 - sympy.Rational(1, 2) * (c[2] - c[3]) * D(m(x), x) * ACC)
+    assert sympy.simplify(series[3] - expected3) == 0
+
+
+def test_eq9_and_eq10_fourth_order_terms():
+    beta = sympy.Symbol("beta")
+    series = bar_row(beta=beta, order=4)
+    assert series[3] == 0
+    stiffness = (-k(x) * D(U, x, 4) / 12 - D(k(x), x) * D(U, x, 3) / 6
+                 - D(k(x), x, 2) * D(U, x, 2) / 4 - D(k(x), x, 3) * D(U, x) / 6)
+    # mass part: our derivation gives m''/4 for the ü term where eq. 9 prints beta m''
+    mass = beta * (m(x) * D(ACC, x, 2) + D(m(x), x) * D(ACC, x)) + D(m(x), x, 2) * ACC / 4
+    assert sympy.simplify(series[4] - (stiffness + mass)) == 0
+    # eq. 10: constant k, m and beta = 1/12 leave (1/12) d²/dx² (-k u'' + m ü)
+    k0, m0 = sympy.symbols("k0 m0", positive=True)
+    uniform = series[4].subs(beta, sympy.Rational(1, 12)).replace(k, lambda s: k0).replace(
+        m, lambda s: m0).doit()
+    assert sympy.simplify(uniform - D(-k0 * D(U, x, 2) + m0 * ACC, x, 2) / 12) == 0
+    # and with beta = 1/6 it does not vanish
+    other = series[4].subs(beta, sympy.Rational(1, 6)).replace(k, lambda s: k0).replace(
+        m, lambda s: m0).doit()
+    assert sympy.simplify(other - D(-k0 * D(U, x, 2) + m0 * ACC, x, 2) / 12) != 0
+
+
+def test_eq12_beam_row_with_eq13_stiffness():
+    series = beam_row(order=5)
+    for p in (0, 1, 2, 3, 5):
+        assert series[p] == 0
+    eq12 = D(k(x) * D(U, x, 2), x, 2) + m(x) * ACC
+    assert sympy.simplify(series[4] - eq12) == 0
+
+
+def test_numeric_nodal_equations_of_known_physics():
+    model = make_model()
+    ei, rho_a = model.bending_rigidity, model.mass_per_length
+    plain = nodal_equations(discretise(model))
+    for eq in plain:
+        assert np.isclose(eq.stiffness[4], ei, rtol=1e-9)
+        assert np.isclose(eq.mass[0], rho_a, rtol=1e-9)
+        assert np.allclose(eq.stiffness[:4], 0.0, atol=1e-6 * ei)
+    tension = 2.0e4
+    loaded = nodal_equations(discretise(model.with_effects(
+        [Effect("axial_load", {"tension": tension})])))
+    assert all(np.isclose(eq.stiffness[2], -tension, rtol=1e-9) for eq in loaded)
+    kf = 3.0e6
+    founded = nodal_equations(discretise(model.with_effects(
+        [Effect("foundation", {"stiffness": kf})])))
+    assert all(np.isclose(eq.stiffness[0], kf, rtol=1e-9) for eq in founded)
+
+
+def test_summaries_name_the_physics():
+    model = make_model()
+    d0 = discretise(model)
+    cases = {
+        "axial_load": ({"tension": 1e4}, "axial load"),
+        "foundation": ({"stiffness": 1e6}, "elastic foundation"),
+        "crack": ({"position": 0.2, "depth_ratio": 0.5}, "local stiffness loss"),
+        "point_mass": ({"position": 0.3, "mass": 0.1}, "attached mass"),
+        "material": ({"E": 2.1e11}, "material change"),
+    }
+    for name, (params, words) in cases.items():
+        lines = summarise(realise(discretise(model.with_effects([Effect(name, params)])), d0))
+        assert len(lines) == 1 and words in lines[0], (name, lines)
+    assert summarise(realise(d0, d0)) == []
