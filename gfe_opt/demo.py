@@ -5,7 +5,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from .cli import _format_params, format_comparison, format_diagnosis
+from .cli import _format_params, _progress, format_comparison, format_diagnosis
 from .correlation import compare
 from .diagnosis import diagnose, update
 from .errors import GfeInputError
@@ -50,7 +50,7 @@ def run_demo(out: Path, force: bool = False) -> int:
     print("\n4. Diagnose: each candidate physical effect is fitted (IPOPT) and ranked by how "
           "much of\n   the error it explains; 'significant' means beyond the measurement "
           "noise.\n")
-    diagnosis = diagnose(model, measured, realise=True)
+    diagnosis = diagnose(model, measured, realise=True, progress=_progress(True))
     print(_indent(format_diagnosis(diagnosis, model)))
     best = diagnosis.best
     if best is None:
@@ -68,7 +68,7 @@ def run_demo(out: Path, force: bool = False) -> int:
     print(f"   the hidden truth was: crack at x = {DEMO_CRACK['position']} m, "
           f"a/d = {DEMO_CRACK['depth_ratio']}")
     print("\n6. Check: diagnose the updated model; nothing significant should be left.\n")
-    again = diagnose(outcome.model, measured)
+    again = diagnose(outcome.model, measured, progress=_progress(True))
     left = again.best
     print("   nothing significant is left" if left is None else
           f"   still significant: {left.effect} ({_format_params(left.parameters)})")
