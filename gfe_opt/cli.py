@@ -50,6 +50,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="relative shape noise that regularises the expansion "
                         "(default %(default)s)")
 
+    def output_options(p):
+        p.add_argument("--plot", metavar="DIR", help="write the figures as PNG into DIR")
+        p.add_argument("--report", metavar="FILE.html",
+                       help="write a self-contained HTML report")
+        p.add_argument("--force", action="store_true",
+                       help="overwrite existing output files")
+
+    output_options(p)
+
     def noise_options(p):
         p.add_argument("--freq-noise", type=_fraction, default=DEFAULT_FREQ_NOISE,
                        help="relative frequency noise σ_f (default %(default)s)")
@@ -64,6 +73,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--candidates", default=",".join(CANDIDATES),
                    help="comma-separated effects to try (default: all)")
     noise_options(g)
+    output_options(g)
 
     u = sub.add_parser("update", help="add effects, fit their parameters, see the error fall")
     u.add_argument("model", help="model file (.toml)")
@@ -71,9 +81,15 @@ def build_parser() -> argparse.ArgumentParser:
     u.add_argument("--add", action="append", required=True, metavar="EFFECT",
                    help="effect to add, e.g. crack or crack:position=0.2 (repeatable)")
     u.add_argument("--out", help="write the updated model (with its [[effects]]) here")
-    u.add_argument("--force", action="store_true", help="overwrite an existing --out file")
     u.add_argument("--json", action="store_true", help="print the result as JSON")
     noise_options(u)
+    output_options(u)
+
+    o = sub.add_parser("modes", help="write a model's modes (w at the nodes) as UFF 55")
+    o.add_argument("model", help="model file (.toml)")
+    o.add_argument("--out", required=True, help="output file (.uff, .unv, .json or .csv)")
+    o.add_argument("--modes", type=int, default=5, help="number of modes (default 5)")
+    o.add_argument("--force", action="store_true", help="overwrite an existing --out file")
 
     d = sub.add_parser("demo", help="the whole story on a synthetic cracked beam")
     d.add_argument("--out", default="gfe-opt-demo",
@@ -113,7 +129,55 @@ def format_comparison(result: Comparison, length: float) -> str:
     return "\n".join(lines)
 
 
+def _check_outputs(args, names) -> None:
+    """Refuse, before any work, outputs that would overwrite inputs or existing files."""
+    inputs = [a for a in (getattr(args, "model", None), getattr(args, "measured", None)) if a]
+    if getattr(args, "plot", None):
+        for name in names:
+            check_output_path(Path(args.plot) / name, args.force, inputs)
+    if getattr(args, "report", None):
+        check_output_path(args.report, args.force, inputs)
+
+
+def _write_outputs(args, figs, fill_report, title) -> None:
+    """Figures into --plot DIR, and the report (``fill_report(report)`` adds its body)."""
+    from .report import Report, save_figures
+
+    if args.plot:
+        paths = save_figures(figs, args.plot)
+        if not args.json:
+            print(f"figures: {', '.join(str(p) for p in paths)}")
+    if args.report:
+        report = Report(title)
+        fill_report(report)
+        for name, fig in figs.items():
+            report.figure(fig, name.removesuffix(".png").replace("_", " "))
+        report.heading("Reproduce")
+        report.preformatted(" ".join(["gfe-opt", *args.argv]))
+        report.save(args.report)
+        if not args.json:
+            print(f"report: {args.report}")
+
+
+COMPARE_FIGURES = ("mac.png", "frequencies.png", "localisation.png")
+
+
+def _comparison_report(report, result, model, measured):
+    report.heading("Comparison")
+    report.paragraph(f"{model.name}: {model.kind}, {model.elements} elements; "
+                     f"{measured.n_modes} measured modes at {measured.n_sensors} sensors.")
+    report.table(["mode", "f_test [Hz]", "f_model [Hz]", "Δf %", "MAC"],
+                 [[p.test_mode, f"{p.test_hz:.2f}", f"{p.model_hz:.2f}",
+                   f"{p.error_pct:+.2f}", f"{p.mac:.3f}"] for p in result.pairs])
+    report.paragraph(f"Frequency error {result.freq_error_rms_pct:.2f} % rms, mean MAC "
+                     f"{result.mac_mean:.3f}.")
+    for x, rel in result.failure_places():
+        report.paragraph(f"The model fails near x = {x:.3f} m "
+                         f"({100 * rel:.0f} % of the largest residual force).")
+
+
 def cmd_compare(args) -> int:
+    _check_outputs(args, COMPARE_FIGURES)
     model = load_model(args.model)
     measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
     result = compare(model, measured, mac_threshold=args.mac_threshold, noise=args.noise)
@@ -123,6 +187,31 @@ def cmd_compare(args) -> int:
         print(f"{model.name}: {model.kind}, {model.elements} elements, "
               f"{measured.n_modes} measured modes at {measured.n_sensors} sensors")
         print(format_comparison(result, model.length))
+    if args.plot or args.report:
+        from .report import compare_figures
+
+        _write_outputs(args, compare_figures(result, model),
+                       lambda r: _comparison_report(r, result, model, measured),
+                       f"gfe-opt compare: {model.name}")
+    return 0
+
+
+def cmd_modes(args) -> int:
+    from .measured import make_measured, save_measured
+    from .modal import model_modes
+
+    check_output_path(args.out, args.force, (args.model,))
+    model = load_model(args.model)
+    if args.modes < 1:
+        raise GfeInputError("--modes", None, f"must be >= 1, got {args.modes}")
+    modes = model_modes(model, args.modes)
+    per = model.dofs_per_node
+    shapes = modes.shapes[::per]  # translations at the nodes
+    keep = np.any(shapes != 0, axis=1)
+    save_measured(make_measured(model.nodes[keep], "w" if model.kind == "beam" else "u",
+                                modes.frequencies_hz, shapes[keep], model.name), args.out)
+    print(f"{args.modes} modes of {model.name} at {int(keep.sum())} nodes written to "
+          f"{args.out}")
     return 0
 
 
@@ -178,6 +267,7 @@ def cmd_diagnose(args) -> int:
     if unknown:
         raise GfeInputError("--candidates", unknown[0], "unknown effect (known: "
                             f"{', '.join(CANDIDATES)})")
+    _check_outputs(args, DIAGNOSIS_FIGURES)
     result = diagnose(model, measured, candidates=candidates, freq_noise=args.freq_noise,
                       shape_noise=args.shape_noise, progress=_progress(not args.json),
                       realise=True)
@@ -185,7 +275,20 @@ def cmd_diagnose(args) -> int:
         print(json.dumps(result.to_json(), indent=1))
     else:
         print(format_diagnosis(result, model))
+    if args.plot or args.report:
+        from .report import diagnosis_figures
+
+        def body(report):
+            report.heading("Diagnosis")
+            report.preformatted(format_diagnosis(result, model))
+
+        _write_outputs(args, diagnosis_figures(result, model), body,
+                       f"gfe-opt diagnose: {model.name}")
     return 0
+
+
+DIAGNOSIS_FIGURES = ("candidates.png", "stiffness_change.png", "slope_change.png",
+                     "disturbance.png", "nodal_equations.png")
 
 
 def cmd_update(args) -> int:
@@ -197,11 +300,27 @@ def cmd_update(args) -> int:
     effects = [parse_effect(a, model) for a in args.add]
     if args.out:  # refuse before the work, not after
         check_output_path(args.out, args.force, (args.model, args.measured))
+    _check_outputs(args, ("error.png",))
     outcome = update(model, measured, effects, freq_noise=args.freq_noise,
                      shape_noise=args.shape_noise)
     if args.out:
         save_model(outcome.model, args.out, force=args.force,
                    protect=(args.model, args.measured))
+    if args.plot or args.report:
+        from .report import update_figures
+
+        def body(report):
+            report.heading("Update")
+            report.table(["", "frequency error [% rms]", "mean MAC"],
+                         [["before", f"{outcome.before.freq_error_rms_pct:.3f}",
+                           f"{outcome.before.mac_mean:.4f}"],
+                          ["after", f"{outcome.after.freq_error_rms_pct:.3f}",
+                           f"{outcome.after.mac_mean:.4f}"]])
+            report.table(["effect", "parameters"],
+                         [[e.name, _format_params(e.parameters)]
+                          for e in outcome.model.effects])
+
+        _write_outputs(args, update_figures(outcome), body, f"gfe-opt update: {model.name}")
     if args.json:
         print(json.dumps(outcome.to_json(), indent=1))
         return 0
@@ -225,11 +344,13 @@ def cmd_demo(args) -> int:
 
 def main(argv=None) -> int:
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
+    args.argv = argv
     np.seterr(all="ignore")
     try:
         return {"compare": cmd_compare, "diagnose": cmd_diagnose, "update": cmd_update,
-                "demo": cmd_demo}[args.command](args)
+                "modes": cmd_modes, "demo": cmd_demo}[args.command](args)
     except GfeInputError as exc:
         print(f"gfe-opt: error: {exc}", file=sys.stderr)
         return 2

@@ -11,7 +11,9 @@ from .diagnosis import diagnose, update
 from .errors import GfeInputError
 from .measured import save_measured
 from .model import Effect, load_model, save_model
+from .plots import error_history
 from .problems import problem_file
+from .report import Report, compare_figures, diagnosis_figures, save_figures
 from .synthetic import interior_sensors, synthetic_measurement
 
 #: The hidden truth of the demo: a crack the starting model does not have.
@@ -24,8 +26,9 @@ def _indent(text: str) -> str:
 
 def run_demo(out: Path, force: bool = False) -> int:
     model_path, measured_path = out / "model.toml", out / "measured.json"
-    updated_path = out / "updated.toml"
-    existing = [p for p in (model_path, measured_path, updated_path) if p.exists()]
+    updated_path, report_path = out / "updated.toml", out / "report.html"
+    existing = [p for p in (model_path, measured_path, updated_path, report_path)
+                if p.exists()]
     if existing and not force:
         raise GfeInputError(str(existing[0]), None,
                             "exists already; pass --force to overwrite the demo's files")
@@ -72,6 +75,37 @@ def run_demo(out: Path, force: bool = False) -> int:
     left = again.best
     print("   nothing significant is left" if left is None else
           f"   still significant: {left.effect} ({_format_params(left.parameters)})")
+    figures = {**compare_figures(result, model), **diagnosis_figures(diagnosis, model),
+               "error.png": error_history([
+                   ("initial model", outcome.before.freq_error_rms_pct),
+                   (f"+ {best.effect}", outcome.after.freq_error_rms_pct)])}
+    save_figures(figures, out / "figures")
+    report = Report("gfe-opt demo: a cracked beam the model did not know about")
+    report.paragraph("Five modes measured at 45 sensors on a simply supported steel beam are "
+                     "compared with an uncracked model; the missing effect is diagnosed, "
+                     "added and fitted, and the error falls to the measurement noise.")
+    report.heading("1. Compare")
+    report.preformatted(format_comparison(result, model.length))
+    report.heading("2. Diagnose")
+    report.preformatted(format_diagnosis(diagnosis, model))
+    report.heading("3. Add the effect")
+    report.table(["", "frequency error [% rms]", "mean MAC"],
+                 [["before", f"{outcome.before.freq_error_rms_pct:.3f}",
+                   f"{outcome.before.mac_mean:.4f}"],
+                  ["after", f"{outcome.after.freq_error_rms_pct:.3f}",
+                   f"{outcome.after.mac_mean:.4f}"]])
+    report.table(["effect", "fitted parameters", "hidden truth"],
+                 [[e.name, _format_params(e.parameters), _format_params(DEMO_CRACK)]
+                  for e in outcome.model.effects])
+    for name, fig in figures.items():
+        report.figure(fig, name.removesuffix(".png").replace("_", " "))
+    report.heading("Reproduce")
+    report.preformatted(f"gfe-opt compare {model_path} {measured_path} --report compare.html\n"
+                        f"gfe-opt diagnose {model_path} {measured_path}\n"
+                        f"gfe-opt update {model_path} {measured_path} --add {best.effect} "
+                        f"--out {updated_path} --force")
+    report.save(report_path)
+    print(f"\nFigures in {out / 'figures'}/, the report in {report_path}.")
     print(f"\nFiles in {out}/. Reproduce with:\n"
           f"  gfe-opt compare {model_path} {measured_path}\n"
           f"  gfe-opt diagnose {model_path} {measured_path}\n"

@@ -413,7 +413,9 @@ class Diagnosis:
     fits: list
     seconds: float
     localisation: list = field(default_factory=list)
-    realisation: list = field(default_factory=list)
+    realisation: list = field(default_factory=list)   # the nodal equations in words
+    nodal: list = field(default_factory=list)         # Realisation per node
+    generic_update: object = None                     # the UpdateResult they come from
 
     def to_json(self) -> dict:
         """The ``diagnose --json`` contract."""
@@ -487,15 +489,18 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=CANDIDATES,
             f.significant = (better_than_reference and f.success
                              and material.misfit.chi2 - f.misfit.chi2 > _threshold(extra))
     fits.sort(key=lambda f: (not f.significant, f.misfit.chi2))
-    words = _generic_realisation(model, measured, shape_noise) if realise else []
+    words, nodal, generic = (_generic_realisation(model, measured, shape_noise) if realise
+                             else ([], [], None))
     return Diagnosis(baseline=baseline, fits=fits, seconds=time.perf_counter() - start,
-                     localisation=localisation, realisation=words)
+                     localisation=localisation, realisation=words, nodal=nodal,
+                     generic_update=generic)
 
 
-def _generic_realisation(model: Model, measured: MeasuredModes, shape_noise: float) -> list:
-    """What the generic-element update's nodal equations say (beams)."""
+def _generic_realisation(model: Model, measured: MeasuredModes, shape_noise: float):
+    """The generic-element update (beams) and what its nodal equations say:
+    ``(words, per-node realisations, UpdateResult)``."""
     if model.kind != "beam":
-        return []
+        return [], [], None
     from .assembly import discretise
     from .realisation import realise, summarise
     from .updating import update_generic
@@ -503,9 +508,10 @@ def _generic_realisation(model: Model, measured: MeasuredModes, shape_noise: flo
     disc = discretise(model)
     result = update_generic(disc, measured, noise=max(shape_noise, 1e-3))
     if not result.ok:
-        return [f"(the generic-element update did not converge: {result.status})"]
-    return summarise(realise(result.discretisation, disc)) or [
-        "no change in the continuous equation beyond the noise"]
+        return [f"(the generic-element update did not converge: {result.status})"], [], result
+    nodal = realise(result.discretisation, disc)
+    words = summarise(nodal) or ["no change in the continuous equation beyond the noise"]
+    return words, nodal, result
 
 
 def _fit_candidate(model, measured, name, params, hint, freq_noise, shape_noise):

@@ -55,7 +55,110 @@ def disturbance_function(x_nodes, q_identified, x_fine, q_exact, *, label_exact:
     ax.plot(x_nodes, q_identified, "o", mfc="none", label="identified $Q_i = 1 + Δk_i/k_0$")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("Q")
-    ax.set_ylim(min(0.0, float(np.min(q_identified)) - 0.05), 1.1)
+    ax.set_ylim(min(0.0, float(np.min(q_identified)) - 0.05),
+                max(1.1, float(np.max(q_identified)) + 0.05))
     ax.set_title("Disturbance function: exact (solid), identified (circles)")
     ax.legend(fontsize=8)
+    return fig
+
+
+def mac_matrix(mac, pairs=()):
+    """MAC heat map (test modes down, model modes across) with the values in the cells."""
+    mac = np.asarray(mac)
+    fig = _figure(1.0 + 0.55 * mac.shape[1], 1.0 + 0.5 * mac.shape[0])
+    ax = fig.add_subplot()
+    image = ax.imshow(mac, vmin=0.0, vmax=1.0, cmap="viridis")
+    for (i, j), value in np.ndenumerate(mac):
+        ax.text(j, i, f"{value:.2f}", ha="center", va="center", fontsize=7,
+                color="black" if value > 0.6 else "white",
+                fontweight="bold" if (i, j) in set(pairs) else "normal")
+    ax.set_xticks(range(mac.shape[1]), [str(j + 1) for j in range(mac.shape[1])])
+    ax.set_yticks(range(mac.shape[0]), [str(i + 1) for i in range(mac.shape[0])])
+    ax.set_xlabel("model mode")
+    ax.set_ylabel("test mode")
+    ax.set_title("MAC (pairs in bold)")
+    fig.colorbar(image, ax=ax, shrink=0.8)
+    return fig
+
+
+def paired_frequencies(pairs):
+    """Test and model frequencies of the pairs, and their errors in %."""
+    fig = _figure(7.0, 3.4)
+    left, right = fig.subplots(1, 2)
+    modes = [p.test_mode for p in pairs]
+    left.plot(modes, [p.test_hz for p in pairs], "o-", label="test")
+    left.plot(modes, [p.model_hz for p in pairs], "s--", label="model")
+    left.set_xlabel("test mode")
+    left.set_ylabel("frequency [Hz]")
+    left.legend(fontsize=8)
+    right.bar(modes, [p.error_pct for p in pairs], color="tab:red")
+    right.axhline(0.0, color="0.5", lw=0.8)
+    right.set_xlabel("test mode")
+    right.set_ylabel("Δf [%]")
+    right.set_title("model − test")
+    return fig
+
+
+def localisation(x, residual, comac, length, supports=("pinned", "pinned")):
+    """Residual force and COMAC along the structure, with the structure drawn below."""
+    fig = _figure(7.0, 4.2)
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))
+    top.plot(x, residual / max(np.max(residual), 1e-300), "o-", ms=3, label="residual force")
+    top.plot(x, comac, "s-", ms=3, label="COMAC")
+    top.set_ylabel("relative value")
+    top.set_ylim(-0.05, 1.1)
+    top.legend(fontsize=8)
+    top.set_title("Where the model fails")
+    bottom.plot([0, length], [0, 0], lw=6, color="0.4", solid_capstyle="butt")
+    bottom.plot(x, np.zeros_like(x), "v", color="tab:blue", ms=4, label="sensors")
+    for end, kind in zip((0.0, length), supports):
+        bottom.annotate(kind, (end, 0), textcoords="offset points", xytext=(0, -14),
+                        ha="center", fontsize=7)
+    bottom.set_yticks([])
+    bottom.set_ylim(-1, 1)
+    bottom.set_xlabel("x [m]")
+    return fig
+
+
+def candidate_errors(fits, baseline_pct):
+    """Frequency error left by each candidate effect (significant ones coloured)."""
+    fig = _figure(7.0, 3.2)
+    ax = fig.add_subplot()
+    names = [f.effect for f in fits]
+    values = [f.misfit.freq_error_rms_pct for f in fits]
+    colours = ["tab:green" if f.significant else "0.6" for f in fits]
+    ax.barh(names[::-1], values[::-1], color=colours[::-1])
+    ax.axvline(baseline_pct, color="tab:red", ls="--", lw=1, label="initial model")
+    ax.set_xlabel("frequency error left [% rms]")
+    ax.set_title("Candidate effects (green: significant)")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def error_history(steps):
+    """Frequency error after each step, ``steps`` a list of ``(label, error_pct)``."""
+    fig = _figure(6.0, 3.2)
+    ax = fig.add_subplot()
+    labels = [s[0] for s in steps]
+    ax.bar(labels, [s[1] for s in steps], color="tab:blue")
+    for i, (_, value) in enumerate(steps):
+        ax.text(i, value, f"{value:.3f} %", ha="center", va="bottom", fontsize=8)
+    ax.set_ylabel("frequency error [% rms]")
+    ax.set_title("Error before and after each added effect")
+    return fig
+
+
+def nodal_coefficients(realisations):
+    """The continuous-equation coefficients per node (k/k0, m/m0, tension, foundation)."""
+    fig = _figure(7.0, 4.0)
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    x = [r.x for r in realisations]
+    top.plot(x, [r.k_ratio for r in realisations], "o-", ms=3, label="k / k0 (w'''')")
+    top.plot(x, [r.mass_ratio for r in realisations], "s-", ms=3, label="m / m0 (ẅ)")
+    top.legend(fontsize=8)
+    top.set_title("Continuous equation at each node")
+    bottom.plot(x, [r.tension for r in realisations], "o-", ms=3, label="T [N] (−T w'')")
+    bottom.plot(x, [r.foundation for r in realisations], "s-", ms=3, label="k_f [N/m²] (w)")
+    bottom.set_xlabel("x [m]")
+    bottom.legend(fontsize=8)
     return fig

@@ -1,0 +1,113 @@
+"""Figures for each command and a self-contained HTML report (figures embedded as PNG)."""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from pathlib import Path
+
+import numpy as np
+
+from . import plots
+from .elements import christides_barr_q
+from .measured import atomic_write
+
+
+def compare_figures(result, model) -> dict:
+    """MAC matrix, paired frequencies and the localisation of a comparison."""
+    pairs = [(p.test_mode - 1, p.model_mode - 1) for p in result.pairs]
+    return {
+        "mac.png": plots.mac_matrix(result.mac_matrix, pairs),
+        "frequencies.png": plots.paired_frequencies(result.pairs),
+        "localisation.png": plots.localisation(result.sensor_x, result.residual, result.comac,
+                                               model.length, model.supports),
+    }
+
+
+def diagnosis_figures(diagnosis, model) -> dict:
+    """Candidate errors; with the generic update: stiffness changes, nodal equation
+    coefficients and (for a crack) the identified Q_i against Christides–Barr Q(x)."""
+    figs = {"candidates.png": plots.candidate_errors(diagnosis.fits,
+                                                     diagnosis.baseline.freq_error_rms_pct)}
+    generic = diagnosis.generic_update
+    if generic is not None and generic.parameterisation.name == "nodal":
+        n = model.elements
+        k0 = model.bending_rigidity
+        x = model.nodes
+        figs["stiffness_change.png"] = plots.parameter_changes(
+            [("k_i", x, 100 * (generic.q[:n + 1] / k0 - 1))], quantity="Δk_i / k_0 [%]",
+            title="Generic-element update: change of the nodal bending stiffness")
+        figs["slope_change.png"] = plots.parameter_changes(
+            [("∂k_i/∂x", x, 100 * generic.q[n + 1:] * model.length / k0)],
+            quantity="Δ(∂k_i/∂x) ℓ / k_0 [%]", title="... and of its slope")
+        best = diagnosis.best
+        if best is not None and best.effect == "crack" and model.depth:
+            fine = np.linspace(0, model.length, 2000)
+            q = christides_barr_q(fine, best.parameters["position"],
+                                  best.parameters["depth_ratio"], model.depth / 2)
+            figs["disturbance.png"] = plots.disturbance_function(
+                x, generic.q[:n + 1] / k0, fine, q,
+                label_exact=f"Q(x), fitted a/d = {best.parameters['depth_ratio']:.2f}")
+    if diagnosis.nodal:
+        figs["nodal_equations.png"] = plots.nodal_coefficients(diagnosis.nodal)
+    return figs
+
+
+def update_figures(outcome) -> dict:
+    """The frequency error before and after the added effects."""
+    names = " + ".join(e.name for e in outcome.model.effects) or "none"
+    return {"error.png": plots.error_history([("before", outcome.before.freq_error_rms_pct),
+                                              (f"after ({names})",
+                                               outcome.after.freq_error_rms_pct)])}
+
+
+def save_figures(figs: dict, folder) -> list[Path]:
+    """Write every figure as PNG into ``folder``; returns the paths."""
+    return [plots.save(fig, Path(folder) / name) for name, fig in figs.items()]
+
+
+class Report:
+    """A self-contained HTML page: headings, text, tables, figures, commands."""
+
+    def __init__(self, title: str):
+        self.title = title
+        self.parts: list[str] = []
+        self.figures = 0
+
+    def heading(self, text: str) -> None:
+        self.parts.append(f"<h2>{html.escape(text)}</h2>")
+
+    def paragraph(self, text: str) -> None:
+        self.parts.append(f"<p>{html.escape(text)}</p>")
+
+    def preformatted(self, text: str) -> None:
+        self.parts.append(f"<pre>{html.escape(text)}</pre>")
+
+    def table(self, headers, rows) -> None:
+        head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
+        body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row)
+                       + "</tr>" for row in rows)
+        self.parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+
+    def figure(self, fig, caption: str) -> None:
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format="png", dpi=110)
+        data = base64.b64encode(buffer.getvalue()).decode("ascii")
+        self.figures += 1
+        self.parts.append(f'<figure><img alt="{html.escape(caption)}" '
+                          f'src="data:image/png;base64,{data}"/>'
+                          f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+    def html(self) -> str:
+        style = ("body{font-family:sans-serif;max-width:60em;margin:2em auto;color:#222}"
+                 "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 8px;"
+                 "text-align:right}th{background:#eee}img{max-width:100%}"
+                 "pre{background:#f6f6f6;padding:.5em;overflow-x:auto}")
+        return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"/>"
+                f"<title>{html.escape(self.title)}</title><style>{style}</style></head>"
+                f"<body><h1>{html.escape(self.title)}</h1>{''.join(self.parts)}</body></html>\n")
+
+    def save(self, path) -> None:
+        text = self.html()
+        atomic_write(Path(path), lambda p: p.write_text(text, encoding="utf-8"))

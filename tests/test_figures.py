@@ -1,0 +1,149 @@
+"""Figures (headless, Agg), the HTML report, and model modes written as UFF."""
+
+import base64
+from html.parser import HTMLParser
+
+import numpy as np
+import pytest
+
+from gfe_opt.cli import main
+from gfe_opt.correlation import compare
+from gfe_opt.diagnosis import diagnose, update
+from gfe_opt.measured import load_measured, save_measured
+from gfe_opt.model import Effect, load_model
+from gfe_opt.problems import problem_file
+from gfe_opt.report import Report, compare_figures, diagnosis_figures, update_figures
+from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+
+NOISE = {"shape_noise": 0.003, "freq_noise": 0.0005}
+
+
+@pytest.fixture(scope="module")
+def case(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("figures")
+    model = load_model(problem_file("ss-steel-beam.toml"))
+    truth = model.with_effects([Effect("crack", {"position": 0.3, "depth_ratio": 0.5})])
+    measured = synthetic_measurement(truth, 4, interior_sensors(model.length, 30), seed=4,
+                                     **NOISE)
+    save_measured(measured, tmp / "measured.json")
+    return model, measured, tmp
+
+
+def _lines(ax):
+    return [len(line.get_xdata()) for line in ax.get_lines()]
+
+
+def test_compare_figures_show_the_data(case):
+    model, measured, _ = case
+    result = compare(model, measured)
+    figs = compare_figures(result, model)
+    mac_ax = figs["mac.png"].axes[0]
+    assert mac_ax.images[0].get_array().shape == result.mac_matrix.shape
+    assert len(mac_ax.texts) == result.mac_matrix.size
+    left, right = figs["frequencies.png"].axes
+    assert _lines(left) == [len(result.pairs)] * 2 and len(right.patches) == len(result.pairs)
+    top = figs["localisation.png"].axes[0]
+    assert _lines(top) == [measured.n_sensors] * 2
+    assert top.get_xlabel() == "" and figs["localisation.png"].axes[1].get_xlabel() == "x [m]"
+
+
+def test_diagnosis_and_update_figures(case):
+    model, measured, _ = case
+    result = diagnose(model, measured, candidates=("material", "crack"), realise=True, **NOISE)
+    figs = diagnosis_figures(result, model)
+    assert set(figs) == {"candidates.png", "stiffness_change.png", "slope_change.png",
+                         "disturbance.png", "nodal_equations.png"}
+    assert len(figs["candidates.png"].axes[0].patches) == len(result.fits)
+    n = model.elements
+    assert _lines(figs["stiffness_change.png"].axes[0])[0] == n + 1
+    assert _lines(figs["disturbance.png"].axes[0]) == [2000, n + 1]
+    assert all(length == n - 1 for length in _lines(figs["nodal_equations.png"].axes[0]))
+    outcome = update(model, measured, ["crack"], **NOISE)
+    bars = update_figures(outcome)["error.png"].axes[0].patches
+    assert len(bars) == 2 and bars[1].get_height() < bars[0].get_height()
+
+
+class _Checker(HTMLParser):
+    """Well-formedness (every opened tag closed in order) and the embedded images."""
+
+    VOID = {"meta", "img", "br", "hr", "link", "input"}
+
+    def __init__(self):
+        super().__init__()
+        self.stack, self.images, self.errors = [], [], []
+
+    def handle_starttag(self, tag, attrs):
+        if tag == "img":
+            self.images.append(dict(attrs)["src"])
+        elif tag not in self.VOID:
+            self.stack.append(tag)
+
+    def handle_startendtag(self, tag, attrs):
+        if tag == "img":
+            self.images.append(dict(attrs)["src"])
+
+    def handle_endtag(self, tag):
+        if not self.stack or self.stack.pop() != tag:
+            self.errors.append(tag)
+
+
+def _check_html(text):
+    checker = _Checker()
+    checker.feed(text)
+    assert not checker.errors and not checker.stack
+    for src in checker.images:
+        assert src.startswith("data:image/png;base64,")
+        assert base64.b64decode(src.split(",", 1)[1])[:8] == b"\x89PNG\r\n\x1a\n"
+    return checker.images
+
+
+def test_report_is_well_formed_and_embeds_every_figure(case):
+    model, measured, tmp = case
+    figs = compare_figures(compare(model, measured), model)
+    report = Report("a <test> & report")
+    report.table(["a", "b"], [[1, "<2>"]])
+    for name, fig in figs.items():
+        report.figure(fig, name)
+    report.save(tmp / "r.html")
+    assert len(_check_html((tmp / "r.html").read_text())) == len(figs)
+
+
+@pytest.mark.parametrize("command,expected", [
+    (["compare"], {"mac.png", "frequencies.png", "localisation.png"}),
+    (["diagnose", "--candidates", "material,crack"],
+     {"candidates.png", "stiffness_change.png", "slope_change.png", "disturbance.png",
+      "nodal_equations.png"}),
+    (["update", "--add", "crack"], {"error.png"}),
+])
+def test_plot_and_report_options(case, tmp_path, capsys, command, expected):
+    _, _, tmp = case
+    args = [command[0], str(problem_file("ss-steel-beam.toml")), str(tmp / "measured.json"),
+            *command[1:], "--plot", str(tmp_path / "plots"), "--report",
+            str(tmp_path / "r.html")]
+    assert main(args) == 0
+    assert {p.name for p in (tmp_path / "plots").iterdir()} == expected
+    text = (tmp_path / "r.html").read_text()
+    assert len(_check_html(text)) == len(expected)
+    assert "gfe-opt " + command[0] in text  # the command that reproduces it
+    assert main(args) == 2  # existing outputs are not overwritten without --force
+    assert "--force" in capsys.readouterr().err
+
+
+def test_modes_written_as_uff_read_back_identically(tmp_path, capsys):
+    import pyuff
+
+    out = tmp_path / "modes.uff"
+    assert main(["modes", str(problem_file("ss-steel-beam.toml")), "--out", str(out),
+                 "--modes", "3"]) == 0
+    sets = pyuff.UFF(str(out)).read_sets()
+    ours = load_measured(out)
+    modal = [s for s in sets if s["type"] == 55]
+    assert [s["type"] for s in sets][0] == 2411 and len(modal) == 3
+    assert np.array_equal([s["freq"] for s in modal], ours.frequencies_hz)
+    assert np.array_equal(np.array([s["r3"] for s in modal]).T, ours.shapes)
+    model = load_model(problem_file("ss-steel-beam.toml"))
+    exact = np.arange(1, 4) ** 2 * np.pi / 2 / model.length**2 * np.sqrt(
+        model.bending_rigidity / model.mass_per_length)
+    assert np.allclose(ours.frequencies_hz, exact, rtol=1e-4)
+    assert main(["modes", str(problem_file("ss-steel-beam.toml")), "--out", str(out)]) == 2
+    assert "exists already" in capsys.readouterr().err
