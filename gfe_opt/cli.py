@@ -143,6 +143,8 @@ def _write_outputs(args, figs, fill_report, title) -> None:
     """Figures into --plot DIR, and the report (``fill_report(report)`` adds its body)."""
     from .report import Report, save_figures
 
+    if not figs:
+        return
     if args.plot:
         paths = save_figures(figs, args.plot)
         if not args.json:
@@ -157,6 +159,14 @@ def _write_outputs(args, figs, fill_report, title) -> None:
         report.save(args.report)
         if not args.json:
             print(f"report: {args.report}")
+
+
+def _figures(build, *args) -> dict:
+    """Figures from ``build``; a missing matplotlib is an input problem with a fix."""
+    try:
+        return build(*args)
+    except ImportError as exc:
+        raise GfeInputError("--plot/--report", None, str(exc)) from None
 
 
 COMPARE_FIGURES = ("mac.png", "frequencies.png", "localisation.png")
@@ -190,7 +200,7 @@ def cmd_compare(args) -> int:
     if args.plot or args.report:
         from .report import compare_figures
 
-        _write_outputs(args, compare_figures(result, model),
+        _write_outputs(args, _figures(compare_figures, result, model),
                        lambda r: _comparison_report(r, result, model, measured),
                        f"gfe-opt compare: {model.name}")
     return 0
@@ -282,7 +292,7 @@ def cmd_diagnose(args) -> int:
             report.heading("Diagnosis")
             report.preformatted(format_diagnosis(result, model))
 
-        _write_outputs(args, diagnosis_figures(result, model), body,
+        _write_outputs(args, _figures(diagnosis_figures, result, model), body,
                        f"gfe-opt diagnose: {model.name}")
     return 0
 
@@ -320,7 +330,8 @@ def cmd_update(args) -> int:
                          [[e.name, _format_params(e.parameters)]
                           for e in outcome.model.effects])
 
-        _write_outputs(args, update_figures(outcome), body, f"gfe-opt update: {model.name}")
+        _write_outputs(args, _figures(update_figures, outcome), body,
+                       f"gfe-opt update: {model.name}")
     if args.json:
         print(json.dumps(outcome.to_json(), indent=1))
         return 0
