@@ -571,7 +571,8 @@ def _solve_ipopt(pb: _Problem, method: str, x_start, max_iter: int):
     """One IPOPT solve; returns ((success, status, stats), (x, free-DOF shapes))."""
     n_x, n_free, m = pb.x0.size, pb.phi0.shape[0], pb.omega.size
     # -- decision variables (scaled to order one) -----------------------------------------
-    z_x = ca.SX.sym("z_x", n_x)
+    symbol = ca.MX if method == "expand" else ca.SX  # MX keeps sparse products whole
+    z_x = symbol.sym("z_x", n_x)
     x = pb.x_scale * z_x
     variables, start_values = [z_x], [np.asarray(x_start) / pb.x_scale]
     # -- objective ------------------------------------------------------------------------

@@ -1,0 +1,139 @@
+"""Speed and scale of gfe-opt, measured as ratios in one run; prints JSON.
+
+    python scripts/bench.py [--max-elements 10000]
+
+1. Generic-element equation-error update (nodal k_i, ∂k_i/∂x; 5 modes; translations at every
+   node, noise-free, from a tapered reference on a twice finer mesh) for N elements: wall
+   time and peak resident memory (each N in a fresh process), and the log-log slope of time
+   against N.
+2. The same update divided by one sparse eigen solve (5 modes) of the same model, N = 2000.
+3. IPOPT equation error, the cvxpy SDP and the output-error baseline at N = 50 and 200:
+   time and parameter error (max relative error of the nodal k_i).
+4. Accuracy at scale: first five frequencies of the simply supported beam against the closed
+   form at N = 10,000, and the parameter error of the update there.
+5. `diagnose` on the 46-element demo beam with 5 modes: wall time.
+"""
+
+import argparse
+import json
+import multiprocessing as mp
+import resource
+import time
+
+import numpy as np
+
+
+def _taper_problem(n):
+    from gfe_opt.measured import make_measured
+    from gfe_opt.model import load_model
+    from gfe_opt.problems import problem_file
+    from gfe_opt.synthetic import full_shapes_at_nodes, reference_with_rigidity
+
+    model = load_model(problem_file("ss-steel-beam.toml")).with_elements(n)
+    ei0 = model.bending_rigidity
+
+    def rigidity(x):
+        return ei0 * (1 + 0.3 * x / model.length)
+
+    reference = reference_with_rigidity(model, rigidity, 2 * n)
+    freqs, shapes = full_shapes_at_nodes(reference, model, 5)
+    measured = make_measured(model.nodes[1:-1], "w", freqs, shapes[2:-2:2], "taper")
+    return model, measured, rigidity(model.nodes)
+
+
+def _update_run(n, queue):
+    from gfe_opt.updating import update_generic
+
+    model, measured, truth = _taper_problem(n)
+    start = time.perf_counter()
+    result = update_generic(model, measured, noise=0.0)
+    seconds = time.perf_counter() - start
+    error = float(np.max(np.abs(result.q[:n + 1] / truth - 1)[1:-1]))
+    queue.put({"elements": n, "seconds": seconds, "ok": result.ok,
+               "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+               "interior_k_error": error})
+
+
+def _in_process(n):
+    ctx = mp.get_context("spawn")
+    queue = ctx.Queue()
+    proc = ctx.Process(target=_update_run, args=(n, queue))
+    proc.start()
+    row = queue.get()
+    proc.join()
+    return row
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--max-elements", type=int, default=10000)
+    args = parser.parse_args()
+    out = {}
+    sizes = [n for n in (100, 300, 1000, 3000, 10000) if n <= args.max_elements]
+    rows = [_in_process(n) for n in sizes]
+    slope = float(np.polyfit(np.log([r["elements"] for r in rows]),
+                             np.log([r["seconds"] for r in rows]), 1)[0])
+    out["update_scaling"] = {"rows": rows, "loglog_slope": slope, "target": "<= 1.2"}
+
+    from gfe_opt.modal import model_modes
+    from gfe_opt.updating import update_generic
+
+    model, measured, truth = _taper_problem(2000)
+    start = time.perf_counter()
+    update_generic(model, measured, noise=0.0)
+    t_update = time.perf_counter() - start
+    start = time.perf_counter()
+    model_modes(model, 5)
+    t_eig = time.perf_counter() - start
+    out["update_over_eigensolve_N2000"] = {"update_s": t_update, "eigensolve_s": t_eig,
+                                           "ratio": t_update / t_eig, "target": "<= 20"}
+
+    from gfe_opt.output_error import update_output_error
+    from gfe_opt.updating import update_sdp
+
+    solvers = []
+    for n in (50, 200):
+        model, measured, truth = _taper_problem(n)
+        for name, run, noise in (("ipopt", update_generic, 0.0), ("sdp", update_sdp, 0.0),
+                                 ("output_error", update_output_error, 1e-4)):
+            start = time.perf_counter()
+            result = run(model, measured, noise=noise)
+            seconds = time.perf_counter() - start
+            solvers.append({"elements": n, "method": name, "seconds": seconds,
+                            "ok": result.ok, "interior_k_error": float(np.max(np.abs(
+                                result.q[:n + 1] / truth - 1)[1:-1]))})
+    by = {(r["elements"], r["method"]): r for r in solvers}
+    out["solvers"] = {"rows": solvers,
+                      "output_error_over_ipopt_time_N200":
+                          by[(200, "output_error")]["seconds"] / by[(200, "ipopt")]["seconds"],
+                      "target": "ipopt >= 50x faster with equal or better accuracy"}
+
+    from gfe_opt.model import load_model
+    from gfe_opt.problems import problem_file
+
+    big = load_model(problem_file("ss-steel-beam.toml")).with_elements(10000)
+    exact = (np.arange(1, 6) * np.pi / big.length) ** 2 * np.sqrt(
+        big.bending_rigidity / big.mass_per_length) / (2 * np.pi)
+    f = model_modes(big, 5).frequencies_hz
+    out["accuracy_N10000"] = {"max_rel_freq_error": float(np.max(np.abs(f / exact - 1))),
+                              "target": "<= 1e-4",
+                              "update_interior_k_error": next(
+                                  (r["interior_k_error"] for r in rows
+                                   if r["elements"] == 10000), None)}
+
+    from gfe_opt.diagnosis import diagnose
+    from gfe_opt.model import Effect
+    from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+
+    model = load_model(problem_file("ss-steel-beam.toml"))
+    truth = model.with_effects([Effect("crack", {"position": 0.19, "depth_ratio": 0.5})])
+    measured = synthetic_measurement(truth, 5, interior_sensors(model.length, 45),
+                                     shape_noise=0.003, freq_noise=0.0005, seed=1)
+    start = time.perf_counter()
+    diagnose(model, measured)
+    out["diagnose_46_elements_s"] = {"seconds": time.perf_counter() - start, "target": "< 3"}
+    print(json.dumps(out, indent=1))
+
+
+if __name__ == "__main__":
+    main()
