@@ -33,12 +33,19 @@ def _fraction(text: str) -> float:
     return value
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one line on stderr, exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="gfe-opt",
         description="Finite-element model updating with generic elements: compare a beam or "
                     "bar model with measured modes and see where it fails.")
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("compare", help="pair model and measured modes; localise the error")
     p.add_argument("model", help="model file (.toml)")
@@ -356,7 +363,10 @@ def cmd_demo(args) -> int:
 def main(argv=None) -> int:
     parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # usage errors (2) and --help (0) from argparse
+        return int(exc.code or 0)
     args.argv = argv
     np.seterr(all="ignore")
     try:

@@ -32,7 +32,7 @@ import scipy.sparse.linalg as spla
 from scipy.optimize import linear_sum_assignment
 
 from .assembly import Discretisation, discretise
-from .errors import GfeSolverError
+from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, sensor_matrix
 from .modal import Modes, discretisation_modes
 from .model import Model
@@ -150,6 +150,22 @@ def _tikhonov_discrepancy(G, y, noise):
     return vt.T @ (s / (s**2 + alpha**2) * beta)
 
 
+def check_frequency_units(measured: MeasuredModes, model_hz) -> None:
+    """Reject measured frequencies that differ from the model's by a factor that points to
+    wrong units (rad/s for Hz, kHz, a model in millimetres): the measured first frequency
+    outside [1/20, 20] times the model's first non-zero one."""
+    model_hz = np.asarray(model_hz)
+    positive = model_hz[model_hz > 0]
+    if positive.size == 0:
+        return
+    ratio = measured.frequencies_hz[0] / positive[0]
+    if not 0.05 <= ratio <= 20.0:
+        raise GfeInputError(measured.source, "modes[0].frequency",
+                            f"{measured.frequencies_hz[0]:.4g} Hz is {ratio:.3g} times the "
+                            f"model's first frequency {positive[0]:.4g} Hz: wrong units "
+                            "(rad/s or kHz for Hz, millimetres for metres) or wrong model?")
+
+
 @dataclass(frozen=True)
 class Pair:
     test_mode: int
@@ -223,6 +239,7 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
     n_model = n_model_modes or min(max(2 * measured.n_modes, measured.n_modes + 4), n_free - 2)
     K, M = disc.global_matrices()
     modes = discretisation_modes(disc, n_model, matrices=(K, M))
+    check_frequency_units(measured, modes.frequencies_hz)
     at_sensors = C @ modes.shapes
     mac_matrix = mac(measured.shapes, at_sensors)
     pairs_idx = pair_modes(mac_matrix, mac_threshold)

@@ -431,6 +431,17 @@ class Diagnosis:
         return next((f for f in self.fits if f.significant), None)
 
 
+def check_enough_modes(measured: MeasuredModes, effects) -> None:
+    """Each fitted effect needs at least as many measured modes as it has parameters (one
+    mode cannot tell a crack's position from its depth); several effects add up."""
+    need = sum(len(EFFECT_PARAMETERS[e.name]) - (1 if e.name == "support_spring" else 0)
+               for e in effects)
+    if measured.n_modes < need:
+        names = " + ".join(e.name for e in effects)
+        raise GfeInputError(measured.source, "modes", f"{names} needs at least {need} "
+                            f"measured modes, the file has {measured.n_modes}")
+
+
 def _threshold(p: int) -> float:
     return float(chi2_dist.ppf(SIGNIFICANCE_LEVEL, p))
 
@@ -463,6 +474,10 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=CANDIDATES,
     for name in candidates:
         if name in present:  # already in the model: re-estimated in every fit
             continue
+        try:
+            check_enough_modes(measured, [*model.effects, Effect(name, {})])
+        except GfeInputError:
+            continue  # too few modes to fit this candidate with the present effects
         sides = ("left", "right", "both") if name == "support_spring" else (None,)
         jobs += [(name, side) for side in sides]
     for done, (name, side) in enumerate(jobs):
@@ -580,6 +595,9 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=DEFAULT_FRE
     model's effects' physical parameters with IPOPT.  Starting values: those given, else
     the diagnosis of each effect alone."""
     effects = [parse_effect(a, model) if isinstance(a, str) else a for a in add]
+    check_enough_modes(measured, [*model.effects,
+                                  *[e for e in effects if e.name not in
+                                    {m.name for m in model.effects}]])
     C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     before = misfit(model, measured, freq_noise, shape_noise, C)
     hint_places = compare(model, measured, noise=max(shape_noise, 1e-3)).failure_places()

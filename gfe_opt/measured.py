@@ -346,8 +346,9 @@ def sensor_matrix(nodes, kind: str, x, dof: str, source="measured") -> sp.csr_ma
     outside = np.flatnonzero((x < nodes[0] - tol) | (x > nodes[-1] + tol))
     if outside.size:
         i = int(outside[0])
+        hint = " (millimetres instead of metres?)" if np.max(x) > 50 * length else ""
         raise GfeInputError(source, f"sensors.x[{i}]", f"{x[i]:g} m lies outside the "
-                            f"structure [{nodes[0]:g}, {nodes[-1]:g}] m")
+                            f"structure [{nodes[0]:g}, {nodes[-1]:g}] m{hint}")
     n_el = len(nodes) - 1
     L = length / n_el
     e = np.clip(np.floor((x - nodes[0]) / L).astype(int), 0, n_el - 1)

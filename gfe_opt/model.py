@@ -227,6 +227,16 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         raise GfeInputError(where, "mass", f"unknown mass model {mass_model!r} "
                             f"(known for a {kind}: {', '.join(mass_models)})")
 
+    if depth is not None and not 1.0 <= length / depth <= 2000.0:
+        raise GfeInputError(where, "length", f"length / depth = {length / depth:.4g} is not a "
+                            "beam or bar (expected 1 to 2000): are length and section in the "
+                            "same unit (metres)?")
+    if not 1e7 <= E <= 1e13:
+        raise GfeInputError(where, "material.E", f"{E:g} Pa is outside 1e7..1e13 Pa: give E in "
+                            "Pa (206e9 for steel, not 206 or 206e3)")
+    if not 100.0 <= rho <= 30000.0:
+        raise GfeInputError(where, "material.rho", f"{rho:g} kg/m^3 is outside 100..30000: "
+                            "give the density in kg/m^3")
     model = Model(name=name, kind=kind, length=length, elements=elements, E=E, rho=rho, nu=nu,
                   area=area, inertia=inertia, supports=supports, depth=depth, breadth=breadth,
                   mass_model=mass_model, source=where)
