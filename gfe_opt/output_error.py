@@ -18,14 +18,14 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import least_squares
 
-from .assembly import Discretisation, discretise
+from .assembly import Discretisation
 from .correlation import DEFAULT_SHAPE_NOISE, mac, pair_modes
 from .errors import GfeSolverError
 from .measured import MeasuredModes
 from .modal import discretisation_modes
 from .model import Model
-from .parameterisation import Parameterisation, parameterisation_for
-from .updating import UpdateResult, _finish, _prepare
+from .parameterisation import Parameterisation
+from .updating import UpdateResult, _finish, _prepare, _setup
 
 
 def update_output_error(model: Model | Discretisation, measured: MeasuredModes, *,
@@ -37,9 +37,7 @@ def update_output_error(model: Model | Discretisation, measured: MeasuredModes, 
 
     ``regularisation`` weighs the same rows as the equation error's, against residuals that
     are relative frequency and shape errors (hence a smaller default)."""
-    disc = discretise(model) if isinstance(model, Model) else model
-    par = parameterisation if isinstance(parameterisation, Parameterisation) else \
-        parameterisation_for(disc.kind, parameterisation, disc.n_elements, disc.element_length)
+    disc, par, regularisation = _setup(model, parameterisation, regularisation, False)
     start = time.perf_counter()
     pb = _prepare(disc, par, measured, noise, regularisation, margin, None)
     free = disc.free

@@ -511,6 +511,16 @@ def _dm(matrix) -> ca.DM:
                  m.data)
 
 
+def _setup(model, parameterisation, regularisation, all_dofs_measured: bool):
+    """The discretisation, the parameterisation object and the regularisation to use."""
+    if regularisation is None:
+        regularisation = default_regularisation(all_dofs_measured)
+    disc = discretise(model) if isinstance(model, Model) else model
+    par = parameterisation if isinstance(parameterisation, Parameterisation) else \
+        parameterisation_for(disc.kind, parameterisation, disc.n_elements, disc.element_length)
+    return disc, par, regularisation
+
+
 def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
                    parameterisation: str | Parameterisation = "nodal", method: str = "expand",
                    noise: float = DEFAULT_SHAPE_NOISE, regularisation: float | None = None,
@@ -533,11 +543,8 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
         raise ValueError(f"unknown method {method!r} (one of {', '.join(METHODS)})")
     if update_mass and method != "expand":
         raise ValueError("mass parameters are updated with method='expand' only")
-    if regularisation is None:
-        regularisation = default_regularisation(full_shapes is not None)
-    disc = discretise(model) if isinstance(model, Model) else model
-    par = parameterisation if isinstance(parameterisation, Parameterisation) else \
-        parameterisation_for(disc.kind, parameterisation, disc.n_elements, disc.element_length)
+    disc, par, regularisation = _setup(model, parameterisation, regularisation,
+                                       full_shapes is not None)
     start = time.perf_counter()
 
     def prepare(expansion_disc=None):
@@ -639,11 +646,8 @@ def update_sdp(model: Model | Discretisation, measured: MeasuredModes, *,
     (linear matrix inequalities in m).  Solved with cvxpy (Clarabel by default, or SCS)."""
     import cvxpy as cp
 
-    if regularisation is None:
-        regularisation = default_regularisation(full_shapes is not None)
-    disc = discretise(model) if isinstance(model, Model) else model
-    par = parameterisation if isinstance(parameterisation, Parameterisation) else \
-        parameterisation_for(disc.kind, parameterisation, disc.n_elements, disc.element_length)
+    disc, par, regularisation = _setup(model, parameterisation, regularisation,
+                                       full_shapes is not None)
     start = time.perf_counter()
     pb = _prepare(disc, par, measured, noise, regularisation, margin, None, full_shapes,
                   None, update_mass)
