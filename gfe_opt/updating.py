@@ -614,6 +614,9 @@ def _solve_ipopt(pb: _Problem, method: str, x_start, max_iter: int):
     # -- solve ----------------------------------------------------------------------------
     solver = ca.nlpsol("equation_error", "ipopt", {"x": ca.vertcat(*variables), "f": J, "g": g},
                        {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
+                        # the adaptive barrier update copes with the wide curvature range
+                        # of fine meshes (N >= 1000 stalled with the monotone default)
+                        "ipopt.mu_strategy": "adaptive",
                         "ipopt.max_iter": max_iter, "ipopt.tol": 1e-8,
                         "ipopt.acceptable_tol": 1e-6})
     try:
