@@ -31,7 +31,11 @@ crack.  ``support_spring`` tries ``left``, ``right`` and ``both`` and keeps the 
 
 from __future__ import annotations
 
+import multiprocessing
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 
 import casadi as ca
@@ -480,14 +484,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=CANDIDATES,
             continue  # too few modes to fit this candidate with the present effects
         sides = ("left", "right", "both") if name == "support_spring" else (None,)
         jobs += [(name, side) for side in sides]
-    for done, (name, side) in enumerate(jobs):
-        if progress:
-            progress(done, len(jobs), name)
-        params = {"side": side} if side else {}
-        fits.append(_fit_candidate(model, measured, name, params, hint, freq_noise,
-                                   shape_noise))
-    if progress:
-        progress(len(jobs), len(jobs), "done")
+    fits = _run_jobs([(model, measured, name, {"side": side} if side else {}, hint,
+                       freq_noise, shape_noise) for name, side in jobs], progress)
     # keep the best side of the support spring
     springs = [f for f in fits if f.effect == "support_spring"]
     if springs:
@@ -527,6 +525,46 @@ def _generic_realisation(model: Model, measured: MeasuredModes, shape_noise: flo
     nodal = realise(result.discretisation, disc)
     words = summarise(nodal) or ["no change in the continuous equation beyond the noise"]
     return words, nodal, result
+
+
+def _run_jobs(jobs, progress):
+    """Fit the candidates, in parallel over the machine's cores (fork, one BLAS thread per
+    worker; serial where processes cannot be forked or only one core is there); results in
+    the order given."""
+    workers = min(len(jobs), os.cpu_count() or 1)
+    if progress:
+        progress(0, len(jobs), "")
+    results = [None] * len(jobs)
+    try:
+        if workers < 2:
+            raise OSError("one core")
+        context = multiprocessing.get_context("fork")
+        with ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                 initializer=_single_threaded_blas) as pool:
+            futures = {pool.submit(_fit_candidate, *job): i for i, job in enumerate(jobs)}
+            for done, future in enumerate(as_completed(futures), start=1):
+                results[futures[future]] = future.result()
+                if progress:
+                    progress(done, len(jobs), jobs[futures[future]][2])
+    except (OSError, ValueError, BrokenProcessPool):
+        for i, job in enumerate(jobs):
+            if results[i] is None:
+                results[i] = _fit_candidate(*job)
+            if progress:
+                progress(i + 1, len(jobs), job[2])
+    return results
+
+
+def _single_threaded_blas():
+    """One BLAS thread per worker: the matrices are small and the workers share the cores
+    (measured: 2.9 s instead of 7.9 s with threaded BLAS in each worker)."""
+    from threadpoolctl import threadpool_limits
+
+    global _BLAS_LIMIT
+    _BLAS_LIMIT = threadpool_limits(limits=1)
+
+
+_BLAS_LIMIT = None
 
 
 def _fit_candidate(model, measured, name, params, hint, freq_noise, shape_noise):
