@@ -165,7 +165,7 @@ def slope_gram(L: float) -> np.ndarray:
     return el.timoshenko_rotary_inertia(1.0, L, 0.0)
 
 
-def cracked_element_stiffness(model: Model, element_stiffness) -> dict:
+def crack_element_parameters(model: Model, element_stiffness) -> dict:
     """Generic parameters of every element of a cracked beam.
 
     EI(x) = EI Π_c Q_c(x) (Christides–Barr, eq. 25); ``element_stiffness`` is
@@ -196,7 +196,7 @@ def cracked_element_stiffness(model: Model, element_stiffness) -> dict:
 
 def _beam_stiffness_params(model: Model, L: float) -> dict:
     if model.effects_named("crack"):
-        out = cracked_element_stiffness(model, el.beam_stiffness_from_flexibility)
+        out = crack_element_parameters(model, el.beam_stiffness_from_flexibility)
     else:
         out = {k: np.full(model.elements, v)
                for k, v in el.euler_bernoulli_stiffness(model.bending_rigidity).items()}

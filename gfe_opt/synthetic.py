@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import elements as el
-from .assembly import cracked_element_stiffness, discretise
+from .assembly import crack_element_parameters, discretise
 from .measured import MeasuredModes, make_measured, sensor_matrix
 from .modal import discretisation_modes
 from .model import Effect, Model
@@ -27,7 +27,7 @@ def reference_discretisation(truth: Model, elements: int):
     disc = discretise(fine.with_effects(e for e in fine.effects if e.name != "crack"))
     if fine.effects_named("shear"):
         raise NotImplementedError("reference with both crack and shear is not provided")
-    params = cracked_element_stiffness(fine, el.beam_stiffness_from_rigidity)
+    params = crack_element_parameters(fine, el.beam_stiffness_from_rigidity)
     return disc.with_stiffness(params)
 
 
