@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 from scipy.optimize import linear_sum_assignment
-from scipy.stats import chi2 as chi2_dist
+from scipy.special import chdtri
 
 from .correlation import compare, mac
 from .errors import GfeInputError, GfeSolverError
@@ -447,7 +447,7 @@ def check_enough_modes(measured: MeasuredModes, effects) -> None:
 
 
 def _threshold(p: int) -> float:
-    return float(chi2_dist.ppf(SIGNIFICANCE_LEVEL, p))
+    return float(chdtri(p, 1.0 - SIGNIFICANCE_LEVEL))  # the χ²(p) quantile
 
 
 def diagnose(model: Model, measured: MeasuredModes, *, candidates=CANDIDATES,
