@@ -40,10 +40,9 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 from scipy.special import chdtri
 
-from .correlation import compare, mac
+from .correlation import compare, mac, pair_modes
 from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, sensor_matrix
 from .modal import model_modes
@@ -95,9 +94,9 @@ def _residuals(model, measured, freq_noise, shape_noise, C=None):
         C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     shapes = C @ modes.shapes
     mac_matrix = mac(measured.shapes, shapes)
-    rows, cols = linear_sum_assignment(-mac_matrix)
-    keep = mac_matrix[rows, cols] >= 0.3
-    rows, cols = rows[keep], cols[keep]
+    pairs = pair_modes(mac_matrix, threshold=0.3)
+    rows = np.array([t for t, _ in pairs], dtype=int)
+    cols = np.array([m for _, m in pairs], dtype=int)
     r = np.zeros((measured.n_modes, 1 + measured.n_sensors))
     r[:, 0] = 0.5 / freq_noise  # an unpaired mode
     f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
@@ -196,7 +195,6 @@ class Fit:
     success: bool
     evaluations: int
     significant: bool = False
-    notes: list = field(default_factory=list)
 
 
 class _Residual(ca.Callback):
@@ -355,7 +353,8 @@ def fit_effects(model: Model, measured: MeasuredModes, adding: list[Effect], *,
     z_start = _grid_start(chi2, variables, z0)
     # -- IPOPT (Gauss-Newton Hessian, finite-difference Jacobian) ------------------------
     n = z_start.size
-    scale = np.sqrt(max(chi2(z_start), 1.0))  # objective starts at 1/2: relative tolerances
+    chi2_start = chi2(z_start)
+    scale = np.sqrt(max(chi2_start, 1.0))  # objective starts at 1/2: relative tolerances
     r_fun = _Residual(lambda z: residual(z) / scale, n, n_res)
     x = ca.MX.sym("z", n)
     solver = ca.nlpsol("effects", "ipopt", {"x": x, "f": 0.5 * ca.sumsqr(r_fun(x))},
@@ -368,7 +367,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding: list[Effect], *,
     sol = solver(x0=z_start, lbx=lower, ubx=upper)
     stats = solver.stats()
     z = np.array(sol["x"]).ravel()
-    if chi2(z) > chi2(z_start):  # never return worse than the start
+    if chi2(z) > chi2_start:  # never return worse than the start
         z = z_start
     effects = effects_of(z)
     fitted = base.with_effects(effects)
@@ -567,6 +566,12 @@ def _single_threaded_blas():
 _BLAS_LIMIT = None
 
 
+def _localisation_hint(model, measured, shape_noise) -> float:
+    """Where :func:`~gfe_opt.correlation.compare` says the model fails, as x / length."""
+    places = compare(model, measured, noise=max(shape_noise, 1e-3)).failure_places()
+    return places[0][0] / model.length if places else 0.5
+
+
 def _fit_candidate(model, measured, name, params, hint, freq_noise, shape_noise):
     """Fit one candidate; crack and point mass also try a start at the localisation."""
     fit = fit_effects(model, measured, [Effect(name, params)], freq_noise=freq_noise,
@@ -638,8 +643,8 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=DEFAULT_FRE
                                     {m.name for m in model.effects}]])
     C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     before = misfit(model, measured, freq_noise, shape_noise, C)
-    hint_places = compare(model, measured, noise=max(shape_noise, 1e-3)).failure_places()
-    hint = hint_places[0][0] / model.length if hint_places else 0.5
+    incomplete = [e for e in effects if set(e.parameters) != set(EFFECT_PARAMETERS[e.name])]
+    hint = _localisation_hint(model, measured, shape_noise) if incomplete else 0.5
     starts = []
     for e in effects:
         if e.name == "support_spring" and "side" not in e.parameters:

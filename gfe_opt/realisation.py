@@ -15,6 +15,7 @@ updated matrices hold.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -200,17 +201,13 @@ def nodal_equations(disc: Discretisation, K=None, M=None) -> list[NodalEquation]
                 for n in range(5):
                     p = n - d
                     if p >= 0:
-                        stiff[n] += kv * h**p / _factorial(p)
+                        stiff[n] += kv * h**p / math.factorial(p)
                 for n in range(3):
                     p = n - d
                     if p >= 0:
-                        mass[n] += mv * h**p / _factorial(p)
+                        mass[n] += mv * h**p / math.factorial(p)
         out.append(NodalEquation(float(nodes[i]), stiff / L, mass / L))
     return out
-
-
-def _factorial(n: int) -> int:
-    return int(np.prod(np.arange(1, n + 1))) if n > 0 else 1
 
 
 def summarise(realisations: list[Realisation]) -> list[str]:

@@ -352,8 +352,11 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
     C_full = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
     y = measured.shapes / np.linalg.norm(measured.shapes, axis=0)
     if full_shapes is None:
-        expander = disc if expansion_disc is None else expansion_disc
-        phi_full = expand_modes(expander, C_full, measured.omega, y, noise).shapes
+        if expansion_disc is None:
+            expander, (K_exp, M_exp) = disc, (K_full, M_full)
+        else:
+            expander, (K_exp, M_exp) = expansion_disc, expansion_disc.global_matrices()
+        phi_full = expand_modes(expander, C_full, measured.omega, y, noise, K_exp, M_exp).shapes
     else:
         phi_full = np.asarray(full_shapes, float)
         if phi_full.shape != (disc.n_dof, measured.n_modes):

@@ -175,3 +175,21 @@ def test_flexibility_element_holds_a_short_soft_zone_exactly():
     # tip rotation of a cantilever (clamped at x = L) under a unit end moment: int 1/EI
     rot = np.linalg.solve(Kp[:2, :2], [0.0, 1.0])[1]
     assert np.isclose(rot, (L - 0.01) / EI + 0.01 / (EI / 10))
+
+
+def test_casadi_evaluates_the_same_bases_as_numpy():
+    # one place for each formula: symbolic parameters go through the same affine bases
+    import casadi as ca
+
+    k = ca.SX.sym("k", 3)
+    symbolic = ca.Function("K", [k], [el.generic_beam_stiffness(k[0], k[1], k[2])])
+    values = np.array([12.0, 5.0, 3.0])
+    assert np.allclose(np.array(symbolic(values)), el.generic_beam_stiffness(*values))
+    m = ca.SX.sym("m", 4)
+    mass = ca.Function("M", [m], [el.symmetric_beam_mass(m[0], m[1], m[2], m[3])])
+    params = np.array(list(el.CONSISTENT_BEAM_MASS.values()))
+    assert np.allclose(np.array(mass(params)), el.symmetric_beam_mass(*params))
+    value = el.SYMMETRIC_BEAM_MASS_CONDITIONS[1].value(dict(zip(("m11", "m12", "m14", "m22"),
+                                                                 (m[i] for i in range(4)))))
+    det = ca.Function("det", [m], [value])
+    assert float(det(params)) > 0
