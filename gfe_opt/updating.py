@@ -63,6 +63,8 @@ from dataclasses import dataclass, field, replace
 import casadi as ca
 import numpy as np
 import scipy.sparse as sp
+from scipy.linalg import cholesky_banded
+from scipy.sparse.linalg import splu, spsolve_triangular
 
 from . import elements as el
 from .assembly import Discretisation, discretise
@@ -73,7 +75,11 @@ from .model import Model
 from .parameterisation import Parameterisation, parameterisation_for
 
 METHODS = ("expand", "bilinear")
+SOLVERS = ("auto", "ipopt")
+WEIGHTINGS = ("rows", "energy")
 ENERGY_FLOOR = 0.05
+#: weighting="energy": σ = ENERGY_SHIFT ω_min² in K̃ = K_0 + σM (positive definite when free)
+ENERGY_SHIFT = 0.01
 
 
 def default_regularisation(all_dofs_measured: bool) -> float:
@@ -300,6 +306,15 @@ class _Problem:
     margin: float
     eq_scale: float = 1.0
     mmap: MassMap | None = None
+    # weighting="energy": Q = K̃ = K_0 + σM (free DOFs), residuals measured as r̂ᵀ K̃⁻¹ r̂
+    metric: sp.csc_matrix | None = None
+    flexibility: object = None  # splu(metric)
+
+    def metric_norms(self, weighted) -> np.ndarray:
+        """Per-mode squared norms of weighted residual columns in the problem's metric."""
+        if self.metric is None:
+            return np.sum(weighted**2, axis=0)
+        return np.einsum("ij,ij->j", weighted, self.flexibility.solve(weighted))
 
     # x = [q; m]: stiffness parameters, then (optionally) uniform mass parameters
     @property
@@ -344,7 +359,7 @@ def _node_energy_share(disc: Discretisation, shapes_full) -> np.ndarray:
 
 
 def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes=None,
-             expansion_disc=None, update_mass=False):
+             expansion_disc=None, update_mass=False, weighting="rows"):
     """Problem data; shapes are expanded with ``disc`` or, when given, ``expansion_disc``
     (the current updated model)."""
     free = disc.free
@@ -367,8 +382,17 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
     d = 1.0 / np.sqrt(M.diagonal())
     node_share = _node_energy_share(disc, phi_full)  # (n_nodes, m)
     per_dof = np.repeat(node_share, disc.dofs_per_node, axis=0)[free]
-    F = np.linalg.norm(measured.omega**2 * (d[:, None] * (M @ phi_full[free])), axis=0)
-    row_weights = np.sqrt(ENERGY_FLOOR + per_dof) * d[:, None] / F
+    inertia = measured.omega**2 * (M @ phi_full[free])
+    metric = flexibility = None
+    if weighting == "energy":
+        metric = (sp.csc_matrix(K_full)[free][:, free]
+                  + ENERGY_SHIFT * np.min(measured.omega) ** 2 * M).tocsc()
+        flexibility = splu(metric)
+        F = np.sqrt(np.einsum("ij,ij->j", inertia, flexibility.solve(inertia)))
+        row_weights = np.ones_like(inertia) / F
+    else:
+        F = np.linalg.norm(d[:, None] * inertia, axis=0)
+        row_weights = np.sqrt(ENERGY_FLOOR + per_dof) * d[:, None] / F
     k_scale = disc.stiffness_params["k_ww"] / 12.0 if disc.kind == "beam" else \
         disc.stiffness_params["k"]
     k0 = float(np.mean(k_scale))
@@ -388,10 +412,11 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
                   phi0=phi_full[free], row_weights=row_weights, q0=np.asarray(q0, float),
                   scale=scale, param_weights=param_weights, k0=k0, noise=noise,
                   regularisation=regularisation, margin=margin,
-                  mmap=mass_map(disc) if update_mass else None)
+                  mmap=mass_map(disc) if update_mass else None, metric=metric,
+                  flexibility=flexibility)
     K0 = pb.kmap.matrix(pb.q0)
     r0 = row_weights * (K0 @ pb.phi0 - measured.omega**2 * (M @ pb.phi0))
-    pb.eq_scale = max(float(np.mean(r0**2)), 1e-300)
+    pb.eq_scale = max(float(np.sum(pb.metric_norms(r0)) / r0.size), 1e-300)
     return pb
 
 
@@ -401,8 +426,9 @@ def _objective_terms(pb: _Problem, x, phi, data_term: bool):
     K = pb.kmap.matrix(x[:pb.n_q])
     res = K @ phi - (pb.omega**2) * (pb.mass_matrix(x) @ phi)
     weighted = pb.row_weights * res
-    per_mode = np.linalg.norm(weighted, axis=0)
-    J = np.mean(weighted**2) / pb.eq_scale
+    squares = pb.metric_norms(weighted)
+    per_mode = np.sqrt(squares)
+    J = np.sum(squares) / weighted.size / pb.eq_scale
     dz = (x - pb.x0) / pb.x_scale
     J += pb.regularisation / x.size * np.sum(pb.x_weights * dz**2)
     if data_term:
@@ -489,6 +515,95 @@ def _energy_balance(pb: _Problem):
     return np.array(rows), np.array(rhs)
 
 
+DIRECT_STATUS = "Solved_Direct_KKT"
+
+
+def _metric_blocks(pb: _Problem):
+    """Q of the expand objective (B z + b)ᵀ Q⁻¹ (B z + b): None for the identity ("rows"),
+    block-diagonal K̃ per mode ("energy")."""
+    return None if pb.metric is None else sp.block_diag([pb.metric] * pb.omega.size, "csc")
+
+
+def _banded_cholesky(Q: sp.csc_matrix) -> sp.csc_matrix:
+    """Lower Cholesky factor of a banded symmetric positive definite sparse matrix."""
+    coo = sp.tril(Q).tocoo()
+    band = int(np.max(coo.row - coo.col)) + 1
+    ab = np.zeros((band, Q.shape[0]))
+    ab[coo.row - coo.col, coo.col] = coo.data
+    factor = cholesky_banded(ab, lower=True)
+    offsets = np.arange(band)
+    return sp.diags([factor[k, :Q.shape[0] - k] for k in offsets], -offsets, format="csc")
+
+
+def _solve_direct(pb: _Problem):
+    """The ``expand`` step without its inequality constraints, by one sparse factorisation.
+
+    With r = B z + b and Q u = r the optimality conditions are the symmetric quasi-definite
+    system [[-Q, B], [Bᵀ, R²]] [u; z] = [-b; R² z0], bordered by the energy-balance rows
+    E z = -c (Schur complement on the few rows).  Quasi-definite matrices factor stably
+    without pivoting in any symmetric order, so SuperLU runs with a minimum-degree order on
+    AᵀA + A and no pivoting; two steps of iterative refinement follow.  Returns
+    (x, relative residual) or None when the factorisation fails or stays inaccurate."""
+    B, b, reg = _expanded_least_squares(pb)
+    z0 = pb.x0 / pb.x_scale
+    E, c = _energy_balance(pb)
+    E = E * pb.x_scale
+    Q = _metric_blocks(pb)
+    if Q is None:
+        Q = sp.identity(b.size, format="csc")
+    else:  # rᵀQ⁻¹r = (Dr)ᵀ(DQD)⁻¹(Dr), D = diag(Q)^-1/2: unit diagonal, force/moment alike
+        D = sp.diags(1.0 / np.sqrt(Q.diagonal()))
+        Q, B, b = (D @ Q @ D).tocsc(), (D @ B).tocsr(), D @ b
+    K = sp.bmat([[-Q, B], [B.T, sp.diags(reg**2)]], format="csc")
+    border = np.vstack([np.zeros((b.size, c.size)), E.T])
+    rhs, rhs_eq = np.concatenate([-b, reg**2 * z0]), -c
+    try:
+        lu = splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                  options={"SymmetricMode": True})
+    except RuntimeError:  # an exactly singular pivot (no regularisation)
+        return None
+    k_border = lu.solve(border)
+    schur = border.T @ k_border
+
+    def solve(r_main, r_eq):
+        y = lu.solve(r_main)
+        lam = np.linalg.solve(schur, border.T @ y - r_eq)
+        return y - k_border @ lam, lam
+
+    y, lam = solve(rhs, rhs_eq)
+    scale = np.linalg.norm(np.concatenate([rhs, rhs_eq]))
+    for _ in range(3):
+        res_main = rhs - K @ y - border @ lam
+        res_eq = rhs_eq - border.T @ y
+        residual = np.linalg.norm(np.concatenate([res_main, res_eq])) / max(scale, 1e-300)
+        if residual < 1e-13:
+            break
+        dy, dlam = solve(res_main, res_eq)
+        y, lam = y + dy, lam + dlam
+    res_main = rhs - K @ y - border @ lam
+    residual = float(np.linalg.norm(np.concatenate([res_main, rhs_eq - border.T @ y]))
+                     / max(scale, 1e-300))
+    if not np.all(np.isfinite(y)) or residual > 1e-8:
+        return None
+    return pb.x_scale * y[b.size:], residual
+
+
+def _solve_step(pb: _Problem, x_start, max_iter: int, solver: str):
+    """One convex ``expand`` step: direct when no inequality is active at the direct solution
+    (the problem is convex, so that point is its optimum), IPOPT otherwise or on request.
+    Returns ((success, status, stats), (x, shapes), solver used)."""
+    if solver == "auto":
+        direct = _solve_direct(pb)
+        if direct is not None:
+            x, residual = direct
+            g, lower = _constraints(pb, x)
+            if np.all(np.array(g, dtype=float).ravel() > lower):
+                info = {"return_status": DIRECT_STATUS, "iter_count": 0,
+                        "kkt_residual": residual}
+                return (True, DIRECT_STATUS, info), (x, pb.phi0), "direct"
+    return _solve_ipopt(pb, "expand", x_start, max_iter) + ("ipopt",)
+
+
 def _constraints(pb: _Problem, x):
     """Feasibility constraints g(x) >= lower bounds (CasADi expressions): element stiffness
     scaled by k0 (>= margin) and the mass conditions (>= MASS_MARGIN)."""
@@ -529,7 +644,8 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
                    noise: float = DEFAULT_SHAPE_NOISE, regularisation: float | None = None,
                    margin: float = 1e-3, q0=None, max_iter: int = 500,
                    full_shapes=None, refinements: int = 2,
-                   update_mass: bool = False) -> UpdateResult:
+                   update_mass: bool = False, solver: str = "auto",
+                   weighting: str = "rows") -> UpdateResult:
     """Update generic stiffness parameters by the equation error (see module docstring).
 
     ``model`` is the initial model (or its discretisation); ``q0`` may replace its parameter
@@ -539,11 +655,20 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
     re-solves the convex problem; the regularisation stays anchored at the initial model).
     ``bilinear`` starts from the ``expand`` solution.  ``update_mass`` adds the uniform
     generic mass parameters (beam m11, m12, m14, m22 of eq. 17; bar β of eq. 2) with their
-    positive-definiteness conditions (``expand`` only).  Never raises for a failed solve:
-    the result's ``success``/``status`` say so and ``ok`` is False.
+    positive-definiteness conditions (``expand`` only).  ``solver="auto"`` solves each
+    convex ``expand`` step by one sparse KKT factorisation and keeps that point when no
+    inequality is active there (convexity makes it the optimum), else calls IPOPT;
+    ``solver="ipopt"`` always calls IPOPT.  ``weighting`` is ``"rows"`` (the module
+    docstring's W) or ``"energy"`` (residual forces in the flexibility metric of the
+    initial model, for fine meshes).  Never raises for a failed solve: the result's
+    ``success``/``status`` say so and ``ok`` is False.
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r} (one of {', '.join(METHODS)})")
+    if solver not in SOLVERS:
+        raise ValueError(f"unknown solver {solver!r} (one of {', '.join(SOLVERS)})")
+    if weighting not in WEIGHTINGS:
+        raise ValueError(f"unknown weighting {weighting!r} (one of {', '.join(WEIGHTINGS)})")
     if update_mass and method != "expand":
         raise ValueError("mass parameters are updated with method='expand' only")
     disc, par, regularisation = _setup(model, parameterisation, regularisation,
@@ -552,18 +677,20 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
 
     def prepare(expansion_disc=None):
         return _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes,
-                        expansion_disc, update_mass)
+                        expansion_disc, update_mass, weighting)
 
     pb = prepare()
     notes = []
-    (success, status, info), (x_opt, phi_opt) = _solve_ipopt(pb, "expand", pb.x0, max_iter)
+    (success, status, info), (x_opt, phi_opt), used = _solve_step(pb, pb.x0, max_iter, solver)
+    solvers = [used]
     for done in range(refinements if full_shapes is None else 0):
         if not success:
             break
         updated = _updated_discretisation(pb, x_opt)
         pb = prepare(updated)
-        (success, status, info), (x_new, phi_opt) = _solve_ipopt(pb, "expand", x_opt,
-                                                                 max_iter)
+        (success, status, info), (x_new, phi_opt), used = _solve_step(pb, x_opt, max_iter,
+                                                                      solver)
+        solvers.append(used)
         step = np.max(np.abs(x_new - x_opt) / pb.x_scale)
         x_opt = x_new
         info["refinements"] = done + 1
@@ -573,8 +700,10 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
         if not success:
             notes.append(f"the expand start did not converge ({status})")
         (success, status, info), (x_opt, phi_opt) = _solve_ipopt(pb, method, x_opt, max_iter)
-    return _finish(pb, method, "ipopt", x_opt, phi_opt, status, success, info,
-                   time.perf_counter() - start, notes)
+        solvers.append("ipopt")
+    info["steps"] = solvers
+    return _finish(pb, method, "ipopt" if "ipopt" in solvers else "direct", x_opt, phi_opt,
+                   status, success, info, time.perf_counter() - start, notes)
 
 
 def _solve_ipopt(pb: _Problem, method: str, x_start, max_iter: int):
@@ -586,9 +715,24 @@ def _solve_ipopt(pb: _Problem, method: str, x_start, max_iter: int):
     x = pb.x_scale * z_x
     variables, start_values = [z_x], [np.asarray(x_start) / pb.x_scale]
     # -- objective ------------------------------------------------------------------------
+    lifted = None
     if method == "expand":
+        # lifted: residual variables u with Q u = B z + b and objective uᵀ Q u (Q = I for
+        # "rows"): no BᵀB is formed, and IPOPT converges to its tolerance (the unlifted
+        # ||B z + b||² stalled at "acceptable" on fine meshes)
         B, b, _ = _expanded_least_squares(pb)
-        J = ca.sumsqr(ca.mtimes(_dm(B), z_x) + b)
+        Q = _metric_blocks(pb)
+        u = ca.MX.sym("u", b.size)
+        r_start = B @ start_values[0] + b
+        if Q is None:
+            J, lifted = ca.sumsqr(u), u - ca.mtimes(_dm(B), z_x)
+            start_values.append(r_start)
+        else:  # Q = L Lᵀ (banded Cholesky): L u = B z + b, J = uᵀu = rᵀ Q⁻¹ r
+            L = _banded_cholesky(pb.metric)
+            Lblk = sp.block_diag([L] * pb.omega.size, "csc")
+            J, lifted = ca.sumsqr(u), ca.mtimes(_dm(Lblk), u) - ca.mtimes(_dm(B), z_x)
+            start_values.append(spsolve_triangular(Lblk.tocsr(), r_start, lower=True))
+        variables.append(u)
     else:
         pat = pb.kmap.pattern
         K = ca.SX(ca.Sparsity(pat.shape[0], pat.shape[1], pat.indptr.tolist(),
@@ -611,9 +755,10 @@ def _solve_ipopt(pb: _Problem, method: str, x_start, max_iter: int):
     g, lbg = _constraints(pb, x)
     ubg = np.full(lbg.size, np.inf)
     if method == "expand":
-        A, b = _energy_balance(pb)
-        g = ca.vertcat(g, ca.mtimes(ca.DM(A), x) + b)
-        lbg, ubg = np.concatenate([lbg, np.zeros(b.size)]), np.concatenate([ubg, np.zeros(b.size)])
+        A, c = _energy_balance(pb)
+        g = ca.vertcat(g, ca.mtimes(ca.DM(A), x) + c, lifted)
+        lbg = np.concatenate([lbg, np.zeros(c.size), b])
+        ubg = np.concatenate([ubg, np.zeros(c.size), b])
     # -- solve ----------------------------------------------------------------------------
     solver = ca.nlpsol("equation_error", "ipopt", {"x": ca.vertcat(*variables), "f": J, "g": g},
                        {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
@@ -645,29 +790,40 @@ def update_sdp(model: Model | Discretisation, measured: MeasuredModes, *,
                parameterisation: str | Parameterisation = "nodal",
                noise: float = DEFAULT_SHAPE_NOISE, regularisation: float | None = None,
                margin: float = 1e-3, full_shapes=None, solver: str = "CLARABEL",
-               update_mass: bool = False) -> UpdateResult:
+               update_mass: bool = False, weighting: str = "rows") -> UpdateResult:
     r"""The ``expand`` problem as a convex SDP: same objective, with every element stiffness
     semidefinite, :math:`P_e / k_0 \succeq m I` where :math:`K_e = H^T P_e H / L^3`
     (bar: :math:`k_e \ge m k_0`), and with ``update_mass`` the mass blocks positive definite
-    (linear matrix inequalities in m).  Solved with cvxpy (Clarabel by default, or SCS)."""
+    (linear matrix inequalities in m).  Solved with cvxpy (Clarabel by default, or SCS).
+    ``weighting="energy"`` is lifted as in IPOPT (L u = B z + b, Q = L Lᵀ)."""
     import cvxpy as cp
 
+    if weighting not in WEIGHTINGS:
+        raise ValueError(f"unknown weighting {weighting!r} (one of {', '.join(WEIGHTINGS)})")
     disc, par, regularisation = _setup(model, parameterisation, regularisation,
                                        full_shapes is not None)
     start = time.perf_counter()
     pb = _prepare(disc, par, measured, noise, regularisation, margin, None, full_shapes,
-                  None, update_mass)
+                  None, update_mass, weighting)
     B, b, reg = _expanded_least_squares(pb)
     z = cp.Variable(pb.x0.size)
     z0 = pb.x0 / pb.x_scale
-    objective = cp.sum_squares(B @ z + b) + cp.sum_squares(cp.multiply(reg, z - z0))
+    constraints = []
+    if pb.metric is None:
+        objective = cp.sum_squares(B @ z + b)
+    else:
+        u = cp.Variable(b.size)
+        constraints.append(sp.block_diag([_banded_cholesky(pb.metric)] * pb.omega.size,
+                                         "csr") @ u == B @ z + b)
+        objective = cp.sum_squares(u)
+    objective += cp.sum_squares(cp.multiply(reg, z - z0))
     p = (par.matrix @ sp.diags(pb.scale) / pb.k0) @ z[:pb.n_q]
     n = par.n_elements
     if disc.kind == "bar":
-        constraints = [p >= margin]
+        constraints.append(p >= margin)
     else:
-        constraints = [cp.bmat([[p[e], p[n + e]], [p[n + e], p[2 * n + e]]]) >> margin * np.eye(2)
-                       for e in range(n)]
+        constraints += [cp.bmat([[p[e], p[n + e]], [p[n + e], p[2 * n + e]]]) >> margin * np.eye(2)
+                        for e in range(n)]
     if pb.mmap is not None:
         mass = z[pb.n_q:] * 0.1
         if disc.kind == "bar":

@@ -10,7 +10,7 @@ from gfe_opt.modal import discretisation_modes
 from gfe_opt.model import Effect
 from gfe_opt.parameterisation import beam_parameterisation
 from gfe_opt.synthetic import full_shapes_at_nodes, reference_with_rigidity, synthetic_measurement
-from gfe_opt.updating import cross_check, update_generic, update_sdp
+from gfe_opt.updating import active_constraints, cross_check, update_generic, update_sdp
 
 from .conftest import STEEL_BAR, make_model
 
@@ -92,14 +92,54 @@ def test_case_study_crack_located_from_noisy_translations(seed):
     assert k.min() < 0.5 * model.bending_rigidity
 
 
-def test_ipopt_and_sdp_agree_on_a_convex_instance():
+@pytest.mark.parametrize("weighting", ["rows", "energy"])
+def test_ipopt_direct_and_sdp_agree_on_a_convex_instance(weighting):
     model = make_model(elements=20)
     measured, shapes = _all_dof_data(model, _dip(model), 3)
-    a = update_generic(model, measured, full_shapes=shapes, noise=0.0)
-    b = update_sdp(model, measured, full_shapes=shapes, noise=0.0)
-    check = cross_check(a, b, tol=1e-5)
-    assert check["agree"], check
-    assert check["active_ipopt"] == check["active_sdp"] == []
+    a = update_generic(model, measured, full_shapes=shapes, noise=0.0, solver="ipopt",
+                       weighting=weighting)
+    b = update_sdp(model, measured, full_shapes=shapes, noise=0.0, weighting=weighting)
+    direct = update_generic(model, measured, full_shapes=shapes, noise=0.0,
+                            weighting=weighting)
+    assert a.solver == "ipopt" and direct.solver == "direct"
+    for check in (cross_check(a, b, tol=1e-5), cross_check(direct, b, tol=1e-5)):
+        assert check["agree"], check
+        assert check["active_ipopt"] == check["active_sdp"] == []
+
+
+def test_active_constraint_hands_the_step_to_ipopt():
+    # a margin the 30 % dip must cross: the direct KKT point is infeasible, so "auto" calls
+    # IPOPT, whose solution sits on the bound and equals the forced-IPOPT one
+    model = make_model(elements=20)
+    measured, shapes = _all_dof_data(model, _dip(model), 3)
+    auto = update_generic(model, measured, full_shapes=shapes, noise=0.0, margin=3.5)
+    forced = update_generic(model, measured, full_shapes=shapes, noise=0.0, margin=3.5,
+                            solver="ipopt")
+    assert auto.solver == "ipopt" and auto.ok, auto.summary()
+    assert active_constraints(auto)
+    assert np.allclose(auto.q, forced.q, rtol=1e-8)
+    free = update_generic(model, measured, full_shapes=shapes, noise=0.0, margin=2.0)
+    assert free.solver == "direct" and not active_constraints(free)
+
+
+def test_energy_weighting_recovers_a_taper_on_10000_elements():
+    # 5 modes, translations at every node of 10,000 elements from a 20,000-element reference:
+    # the row-weighted residual (K - ω²M)φ amplifies rounding in φ by (N/jπ)^4 ~ 1e14 and
+    # loses the taper; measured in the initial model's flexibility it does not
+    model = make_model(elements=10000)
+    rigidity = _taper(model)
+    ref = reference_with_rigidity(model, rigidity, 2 * model.elements)
+    freqs, shapes = full_shapes_at_nodes(ref, model, 5)
+    measured = make_measured(model.nodes[1:-1], "w", freqs, shapes[2:-2:2], "reference")
+    middle = slice(model.elements // 20, -model.elements // 20)  # pinned ends: held
+    errors = {}
+    for weighting in ("rows", "energy"):
+        result = update_generic(model, measured, noise=0.0, weighting=weighting)
+        assert result.ok and result.solver == "direct", result.summary()
+        k = result.q[:model.elements + 1]
+        errors[weighting] = np.max(np.abs(k / rigidity(model.nodes) - 1)[middle])
+    assert errors["energy"] < 0.025   # measured 0.020 (0.5 % on the middle 80 %)
+    assert errors["rows"] > 5 * errors["energy"]   # measured 0.24
 
 
 def test_cross_check_reports_disagreement():
@@ -126,7 +166,8 @@ def test_infeasible_start_is_handled():
 def test_failed_solve_is_reported_not_hidden():
     model = make_model(elements=20)
     measured, shapes = _all_dof_data(model, _dip(model), 3)
-    result = update_generic(model, measured, full_shapes=shapes, noise=0.0, max_iter=2)
+    result = update_generic(model, measured, full_shapes=shapes, noise=0.0, max_iter=2,
+                            solver="ipopt")
     assert not result.success and not result.ok
     assert "Maximum_Iterations" in result.status
     assert any("must not be used" in n for n in result.notes)
