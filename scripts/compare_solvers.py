@@ -50,14 +50,16 @@ def main():
         truth = _true_k_ww(problem)
         runs = {
             "ipopt equation error": lambda p=problem, f=full, n=noise: update_generic(
-                p.model, p.measured, noise=max(n, 1e-4), **f),
+                p.model, p.measured, noise=max(n, 1e-4), solver="ipopt", **f),
+            "equation error (auto: direct KKT)": lambda p=problem, f=full, n=noise:
+                update_generic(p.model, p.measured, noise=max(n, 1e-4), **f),
             "cvxpy SDP (one convex step)": lambda p=problem, f=full, n=noise: update_sdp(
                 p.model, p.measured, noise=max(n, 1e-4), **f),
             "output error (least_squares)": lambda p=problem, n=noise: update_output_error(
                 p.model, p.measured, noise=max(n, 1e-4)),
         }
         same_step = update_generic(problem.model, problem.measured, noise=max(noise, 1e-4),
-                                   refinements=0, **full)
+                                   refinements=0, solver="ipopt", **full)
         check = cross_check(same_step, runs["cvxpy SDP (one convex step)"]())
         checks.append({"problem": label, **check})
         for method, run in runs.items():

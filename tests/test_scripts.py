@@ -27,9 +27,15 @@ def test_paper_case_study(tmp_path):
 def test_compare_solvers(tmp_path):
     out = _run("compare_solvers.py", cwd=tmp_path)
     rows = json.loads(out[out.index("\n[") + 1:])
-    assert len(rows) == 9
+    assert len(rows) == 12
     taper = [r for r in rows if r["problem"].startswith("tapered")]
     assert all(r["ok"] for r in taper)
+    by = {(r["problem"], r["method"]): r for r in rows}
+    for problem in {r["problem"] for r in rows}:  # same optimum by the direct KKT and IPOPT
+        a = by[(problem, "ipopt equation error")]
+        b = by[(problem, "equation error (auto: direct KKT)")]
+        assert b["iterations"] == 0
+        assert abs(a["parameter_error_rms"] - b["parameter_error_rms"]) < 1e-6
     assert out.count("agree=True") == 3  # IPOPT and the SDP on the same convex step
 
 
