@@ -75,11 +75,11 @@ def main():
                 "freq_error_rms_pct": float(100 * np.sqrt(np.mean(
                     (f / problem.measured.frequencies_hz - 1) ** 2))),
             })
-    header = f"{'problem':54} {'method':30} {'ok':>3} {'time s':>7} {'iter':>5} " \
+    header = f"{'problem':54} {'method':33} {'ok':>3} {'time s':>7} {'iter':>5} " \
              f"{'param err':>9} {'f err %':>8}"
     print(header)
     for r in rows:
-        print(f"{r['problem']:54} {r['method']:30} {'yes' if r['ok'] else 'NO':>3} "
+        print(f"{r['problem']:54} {r['method']:33} {'yes' if r['ok'] else 'NO':>3} "
               f"{r['seconds']:7.3f} {r['iterations']!s:>5} {r['parameter_error_rms']:9.4f} "
               f"{r['freq_error_rms_pct']:8.4f}")
     print("\nIPOPT (one convex step) against the SDP on the same data:")
