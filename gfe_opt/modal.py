@@ -53,22 +53,28 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     free = np.setdiff1d(np.arange(n), np.asarray(constrained, dtype=int))
     if n_modes < 1 or n_modes > len(free) - 1:
         raise ValueError(f"n_modes must lie in [1, {len(free) - 1}], got {n_modes}")
-    Kf = sp.csc_matrix(K)[free][:, free]
-    Mf = sp.csc_matrix(M)[free][:, free]
-    dm = Mf.diagonal()
-    dk = Kf.diagonal()
+    dense = len(free) <= DENSE_LIMIT
+    if dense:  # small models: numpy throughout (sparse slicing costs more than the solve)
+        Kf = (K.toarray() if sp.issparse(K) else np.asarray(K))[np.ix_(free, free)]
+        Mf = (M.toarray() if sp.issparse(M) else np.asarray(M))[np.ix_(free, free)]
+        dm, dk = np.diag(Mf), np.diag(Kf)
+    else:
+        Kf = sp.csc_matrix(K)[free][:, free]
+        Mf = sp.csc_matrix(M)[free][:, free]
+        dm, dk = Mf.diagonal(), Kf.diagonal()
     if eigenvalue_scale is None:
         eigenvalue_scale = 1e-8 * float(np.max(dk / np.where(dm > 0, dm, np.inf)))
     d = np.where(dm > 0, 1.0 / np.sqrt(np.where(dm > 0, dm, 1.0)),
                  1.0 / np.sqrt(np.maximum(dk, 1e-300) / eigenvalue_scale))
-    D = sp.diags(d)
-    Ks = (D @ Kf @ D).tocsc()
-    Ms = (D @ Mf @ D).tocsc()
     sigma = -eigenvalue_scale
     try:
-        if len(free) <= DENSE_LIMIT:
-            lam, vec = sla.eigh(Ks.toarray(), Ms.toarray(), subset_by_index=[0, n_modes - 1])
+        if dense:
+            dd = np.outer(d, d)
+            lam, vec = sla.eigh(Kf * dd, Mf * dd, subset_by_index=[0, n_modes - 1])
         else:
+            D = sp.diags(d)
+            Ks = (D @ Kf @ D).tocsc()
+            Ms = (D @ Mf @ D).tocsc()
             lu = spla.splu((Ks - sigma * Ms).tocsc())
             op = spla.LinearOperator(Ks.shape, matvec=lu.solve, dtype=float)
             lam, vec = spla.eigsh(Ks, k=n_modes, M=Ms, sigma=sigma, which="LM", OPinv=op,
