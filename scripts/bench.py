@@ -10,7 +10,7 @@
    with the default solver (direct KKT, IPOPT when a constraint is active) and with IPOPT
    forced on every step.
 3. Equation error by IPOPT (forced) and by the default solver, the cvxpy SDP and the
-   output-error baseline at N = 50 and 200: time and parameter error.
+   output-error baseline at N = 50 and 200: time (best of 3 runs each) and parameter error.
 4. Accuracy at scale: first five frequencies of the simply supported beam against the closed
    form at N = 10,000, and the parameter error of the update there, with the row weighting
    and the energy weighting.
@@ -28,6 +28,8 @@ import resource
 import time
 
 import numpy as np
+
+REPEATS = 3
 
 
 def _taper_problem(n):
@@ -122,9 +124,11 @@ def main():
         for name, run, noise in (("ipopt", forced_ipopt, 0.0), ("auto", update_generic, 0.0),
                                  ("sdp", update_sdp, 0.0),
                                  ("output_error", update_output_error, 1e-4)):
-            start = time.perf_counter()
-            result = run(model, measured, noise=noise)
-            seconds = time.perf_counter() - start
+            seconds = np.inf
+            for _ in range(REPEATS):  # best of REPEATS: the fast solves are timer-noisy
+                start = time.perf_counter()
+                result = run(model, measured, noise=noise)
+                seconds = min(seconds, time.perf_counter() - start)
             solvers.append({"elements": n, "method": name, "seconds": seconds,
                             "ok": result.ok, **_errors(result.q, truth)})
     by = {(r["elements"], r["method"]): r for r in solvers}
