@@ -579,7 +579,7 @@ def _solve_direct(pb: _Problem):
     system [[-Q, B], [Bᵀ, R²]] [u; z] = [-b; R² z0], bordered by the energy-balance rows
     E z = -c (Schur complement on the few rows).  Quasi-definite matrices factor stably
     without pivoting in any symmetric order, so SuperLU runs with a minimum-degree order on
-    AᵀA + A and no pivoting; two steps of iterative refinement follow.  Returns
+    AᵀA + A and no pivoting; up to three steps of iterative refinement follow.  Returns
     (x, relative residual) or None when the factorisation fails or stays inaccurate."""
     B, b, reg = _expanded_least_squares(pb)
     z0 = pb.x0 / pb.x_scale
@@ -607,7 +607,10 @@ def _solve_direct(pb: _Problem):
         lam = np.linalg.solve(schur, border.T @ y - r_eq)
         return y - k_border @ lam, lam
 
-    y, lam = solve(rhs, rhs_eq)
+    try:
+        y, lam = solve(rhs, rhs_eq)
+    except np.linalg.LinAlgError:  # dependent energy-balance rows: leave it to IPOPT
+        return None
     scale = np.linalg.norm(np.concatenate([rhs, rhs_eq]))
     for _ in range(3):
         res_main = rhs - K @ y - border @ lam
@@ -708,6 +711,8 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
         raise ValueError(f"unknown weighting {weighting!r} (one of {', '.join(WEIGHTINGS)})")
     if update_mass and method != "expand":
         raise ValueError("mass parameters are updated with method='expand' only")
+    if weighting == "energy" and method != "expand":
+        raise ValueError("weighting='energy' is available with method='expand' only")
     disc, par, regularisation = _setup(model, parameterisation, regularisation,
                                        full_shapes is not None)
     start = time.perf_counter()

@@ -215,3 +215,14 @@ def test_beam_mass_update_stays_positive_definite_and_matches_sdp():
     before = discretisation_modes(discretise(beam), 3).frequencies_hz
     after = discretisation_modes(a.discretisation, 3).frequencies_hz
     assert np.max(np.abs(after / freqs - 1)) < 1e-3 * np.max(np.abs(before / freqs - 1))
+
+
+@pytest.mark.parametrize("options,message", [
+    ({"solver": "gurobi"}, "unknown solver"), ({"weighting": "mass"}, "unknown weighting"),
+    ({"weighting": "energy", "method": "bilinear"}, "expand"),
+])
+def test_bad_update_options_are_refused(options, message):
+    model = make_model(elements=10)
+    measured, shapes = _all_dof_data(model, _taper(model), 2)
+    with pytest.raises(ValueError, match=message):
+        update_generic(model, measured, **options)
