@@ -58,8 +58,10 @@ complement; iterative refinement to a relative residual below 1e-8).  If every e
 condition holds strictly there, that point is the optimum of the constrained problem (a convex
 problem whose inequality multipliers are all zero), and the step is reported as
 ``Solved_Direct_KKT``; otherwise IPOPT solves the step with its constraints.
-``solver="ipopt"`` calls IPOPT for every step (lifted the same way: residual variables u with
-``Q u = B z + b``; the unlifted ``||B z + b||²`` stalled at "acceptable" on fine meshes).
+``solver="ipopt"`` calls IPOPT for every step, lifted too: residual variables u with
+``u = B z + b`` (or ``L u = B z + b``, Q = L Lᵀ by a banded Cholesky factorisation, for the
+energy weighting) and objective uᵀu; the unlifted ``||B z + b||²`` stalled at "acceptable"
+on fine meshes.
 Measured (scripts/bench.py, N = 2000): the direct step is about 10x faster than IPOPT's; both
 give the same parameters to 1e-8 where no constraint is active (tests/test_updating.py).
 
@@ -759,9 +761,10 @@ def _solve_ipopt(pb: _Problem, method: str, x_start, max_iter: int):
     # -- objective ------------------------------------------------------------------------
     lifted = None
     if method == "expand":
-        # lifted: residual variables u with Q u = B z + b and objective uᵀ Q u (Q = I for
-        # "rows"): no BᵀB is formed, and IPOPT converges to its tolerance (the unlifted
-        # ||B z + b||² stalled at "acceptable" on fine meshes)
+        # lifted: residual variables u = B z + b ("rows") or L u = B z + b with Q = L Lᵀ
+        # ("energy"), objective uᵀu: no BᵀB is formed, and IPOPT converges to its tolerance
+        # (the unlifted ||B z + b||² stalled at "acceptable" on fine meshes; the energy
+        # metric as uᵀQu with Q u = B z + b failed in the step computation at N = 2000)
         B, b, _ = _expanded_least_squares(pb)
         Q = _metric_blocks(pb)
         u = ca.MX.sym("u", b.size)
