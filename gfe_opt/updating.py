@@ -95,7 +95,7 @@ from dataclasses import dataclass, field, replace
 import casadi as ca
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import cholesky_banded
+from scipy.linalg import cho_solve_banded, cholesky_banded
 from scipy.sparse.linalg import splu, spsolve_triangular
 
 from . import elements as el
@@ -318,6 +318,35 @@ class UpdateResult:
         return "\n".join(lines)
 
 
+@dataclass(frozen=True)
+class Flexibility:
+    """Q = K̃ = K_0 + σM on the free DOFs (``weighting="energy"``), factored once as Q = L Lᵀ
+    (banded Cholesky; the DOFs are numbered node by node, so Q is banded)."""
+
+    Q: sp.csc_matrix
+    factor: np.ndarray  # lower banded form of L (scipy.linalg.cholesky_banded)
+
+    @classmethod
+    def of(cls, Q) -> Flexibility:
+        Q = sp.csc_matrix(Q)
+        coo = sp.tril(Q).tocoo()
+        band = int(np.max(coo.row - coo.col)) + 1
+        ab = np.zeros((band, Q.shape[0]))
+        ab[coo.row - coo.col, coo.col] = coo.data
+        return cls(Q=Q, factor=cholesky_banded(ab, lower=True))
+
+    def solve(self, b) -> np.ndarray:
+        """Q⁻¹ b."""
+        return cho_solve_banded((self.factor, True), b)
+
+    def lower_blocks(self, n_blocks: int) -> sp.csc_matrix:
+        """blockdiag(L, ..., L), one block per mode."""
+        n = self.Q.shape[0]
+        offsets = np.arange(self.factor.shape[0])
+        L = sp.diags([self.factor[k, :n - k] for k in offsets], -offsets, format="csc")
+        return sp.block_diag([L] * n_blocks, "csc")
+
+
 @dataclass
 class _Problem:
     disc: Discretisation
@@ -338,13 +367,13 @@ class _Problem:
     margin: float
     eq_scale: float = 1.0
     mmap: MassMap | None = None
-    # weighting="energy": Q = K̃ = K_0 + σM (free DOFs), residuals measured as r̂ᵀ K̃⁻¹ r̂
-    metric: sp.csc_matrix | None = None
-    flexibility: object = None  # splu(metric)
+    # weighting="energy": residuals measured as r̂ᵀ K̃⁻¹ r̂ (None: Euclidean, "rows")
+    flexibility: Flexibility | None = None
+    _jacobians: dict = field(default_factory=dict, repr=False)
 
     def metric_norms(self, weighted) -> np.ndarray:
         """Per-mode squared norms of weighted residual columns in the problem's metric."""
-        if self.metric is None:
+        if self.flexibility is None:
             return np.sum(weighted**2, axis=0)
         return np.einsum("ij,ij->j", weighted, self.flexibility.solve(weighted))
 
@@ -371,21 +400,22 @@ class _Problem:
         return self.M if self.mmap is None else self.mmap.matrix(x[self.n_q:])
 
     def mode_jacobian(self, j: int):
-        """``jacobian(j, φ0_j)`` for the problem's own shapes, computed once."""
-        cache = self.__dict__.setdefault("_jacobians", {})
-        if j not in cache:
-            cache[j] = self.jacobian(j, self.phi0[:, j])
-        return cache[j]
-
-    def jacobian(self, j: int, phi):
-        """(A, c) with (K(q) - ω_j² M(m)) φ = A x + c for a fixed φ (free DOFs)."""
+        """(A, c) with (K(q) - ω_j² M(m)) φ = A x + c for the problem's shape φ0_j (free
+        DOFs), computed once."""
+        if j in self._jacobians:
+            return self._jacobians[j]
+        phi = self.phi0[:, j]
         w2 = self.omega[j] ** 2
         A = self.kmap.jacobian_times(phi)
         c = self.kmap.extra_matrix() @ phi
         if self.mmap is None:
-            return A, c - w2 * (self.M @ phi)
-        H = np.stack([b @ phi for b in self.mmap.basis], axis=1)
-        return sp.hstack([A, sp.csr_matrix(-w2 * H)]).tocsr(), c - w2 * (self.mmap.rest @ phi)
+            out = A, c - w2 * (self.M @ phi)
+        else:
+            H = np.stack([b @ phi for b in self.mmap.basis], axis=1)
+            out = (sp.hstack([A, sp.csr_matrix(-w2 * H)]).tocsr(),
+                   c - w2 * (self.mmap.rest @ phi))
+        self._jacobians[j] = out
+        return out
 
 
 def _node_energy_share(disc: Discretisation, shapes_full) -> np.ndarray:
@@ -422,11 +452,10 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
     node_share = _node_energy_share(disc, phi_full)  # (n_nodes, m)
     per_dof = np.repeat(node_share, disc.dofs_per_node, axis=0)[free]
     inertia = measured.omega**2 * (M @ phi_full[free])
-    metric = flexibility = None
+    flexibility = None
     if weighting == "energy":
-        metric = (sp.csc_matrix(K_full)[free][:, free]
-                  + ENERGY_SHIFT * np.min(measured.omega) ** 2 * M).tocsc()
-        flexibility = splu(metric)
+        flexibility = Flexibility.of(sp.csc_matrix(K_full)[free][:, free]
+                                     + ENERGY_SHIFT * np.min(measured.omega) ** 2 * M)
         F = np.sqrt(np.einsum("ij,ij->j", inertia, flexibility.solve(inertia)))
         row_weights = np.ones_like(inertia) / F
     else:
@@ -451,8 +480,7 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
                   phi0=phi_full[free], row_weights=row_weights, q0=np.asarray(q0, float),
                   scale=scale, param_weights=param_weights, k0=k0, noise=noise,
                   regularisation=regularisation, margin=margin,
-                  mmap=mass_map(disc) if update_mass else None, metric=metric,
-                  flexibility=flexibility)
+                  mmap=mass_map(disc) if update_mass else None, flexibility=flexibility)
     K0 = pb.kmap.matrix(pb.q0)
     r0 = row_weights * (K0 @ pb.phi0 - measured.omega**2 * (M @ pb.phi0))
     pb.eq_scale = max(float(np.sum(pb.metric_norms(r0)) / r0.size), 1e-300)
@@ -557,21 +585,6 @@ def _energy_balance(pb: _Problem):
 DIRECT_STATUS = "Solved_Direct_KKT"
 
 
-def _metric_blocks(pb: _Problem):
-    """Q of the expand objective (B z + b)ᵀ Q⁻¹ (B z + b): None for the identity ("rows"),
-    block-diagonal K̃ per mode ("energy")."""
-    return None if pb.metric is None else sp.block_diag([pb.metric] * pb.omega.size, "csc")
-
-
-def _banded_cholesky(Q: sp.csc_matrix) -> sp.csc_matrix:
-    """Lower Cholesky factor of a banded symmetric positive definite sparse matrix."""
-    coo = sp.tril(Q).tocoo()
-    band = int(np.max(coo.row - coo.col)) + 1
-    ab = np.zeros((band, Q.shape[0]))
-    ab[coo.row - coo.col, coo.col] = coo.data
-    factor = cholesky_banded(ab, lower=True)
-    offsets = np.arange(band)
-    return sp.diags([factor[k, :Q.shape[0] - k] for k in offsets], -offsets, format="csc")
 
 
 def _solve_direct(pb: _Problem):
@@ -587,10 +600,11 @@ def _solve_direct(pb: _Problem):
     z0 = pb.x0 / pb.x_scale
     E, c = _energy_balance(pb)
     E = E * pb.x_scale
-    Q = _metric_blocks(pb)
-    if Q is None:
+    if pb.flexibility is None:
         Q = sp.identity(b.size, format="csc")
-    else:  # rᵀQ⁻¹r = (Dr)ᵀ(DQD)⁻¹(Dr), D = diag(Q)^-1/2: unit diagonal, force/moment alike
+    else:  # Q = blockdiag(K̃) per mode; rᵀQ⁻¹r = (Dr)ᵀ(DQD)⁻¹(Dr) with D = diag(Q)^-1/2:
+        # unit diagonal, force and moment rows alike
+        Q = sp.block_diag([pb.flexibility.Q] * pb.omega.size, "csc")
         D = sp.diags(1.0 / np.sqrt(Q.diagonal()))
         Q, B, b = (D @ Q @ D).tocsc(), (D @ B).tocsr(), D @ b
     K = sp.bmat([[-Q, B], [B.T, sp.diags(reg**2)]], format="csc")
@@ -766,17 +780,15 @@ def _solve_ipopt(pb: _Problem, method: str, x_start, max_iter: int):
         # (the unlifted ||B z + b||² stalled at "acceptable" on fine meshes; the energy
         # metric as uᵀQu with Q u = B z + b failed in the step computation at N = 2000)
         B, b, _ = _expanded_least_squares(pb)
-        Q = _metric_blocks(pb)
         u = ca.MX.sym("u", b.size)
         r_start = B @ start_values[0] + b
-        if Q is None:
+        if pb.flexibility is None:
             J, lifted = ca.sumsqr(u), u - ca.mtimes(_dm(B), z_x)
             start_values.append(r_start)
-        else:  # Q = L Lᵀ (banded Cholesky): L u = B z + b, J = uᵀu = rᵀ Q⁻¹ r
-            L = _banded_cholesky(pb.metric)
-            Lblk = sp.block_diag([L] * pb.omega.size, "csc")
-            J, lifted = ca.sumsqr(u), ca.mtimes(_dm(Lblk), u) - ca.mtimes(_dm(B), z_x)
-            start_values.append(spsolve_triangular(Lblk.tocsr(), r_start, lower=True))
+        else:  # Q = L Lᵀ: L u = B z + b, J = uᵀu = rᵀ Q⁻¹ r
+            L = pb.flexibility.lower_blocks(pb.omega.size)
+            J, lifted = ca.sumsqr(u), ca.mtimes(_dm(L), u) - ca.mtimes(_dm(B), z_x)
+            start_values.append(spsolve_triangular(L.tocsr(), r_start, lower=True))
         variables.append(u)
     else:
         pat = pb.kmap.pattern
@@ -854,12 +866,11 @@ def update_sdp(model: Model | Discretisation, measured: MeasuredModes, *,
     z = cp.Variable(pb.x0.size)
     z0 = pb.x0 / pb.x_scale
     constraints = []
-    if pb.metric is None:
+    if pb.flexibility is None:
         objective = cp.sum_squares(B @ z + b)
     else:
         u = cp.Variable(b.size)
-        constraints.append(sp.block_diag([_banded_cholesky(pb.metric)] * pb.omega.size,
-                                         "csr") @ u == B @ z + b)
+        constraints.append(pb.flexibility.lower_blocks(pb.omega.size) @ u == B @ z + b)
         objective = cp.sum_squares(u)
     objective += cp.sum_squares(cp.multiply(reg, z - z0))
     p = (par.matrix @ sp.diags(pb.scale) / pb.k0) @ z[:pb.n_q]
