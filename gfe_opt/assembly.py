@@ -2,14 +2,26 @@
 
 The stiffness of every element is held as *generic parameters* (eq. 2 for a bar, eq. 11 for a
 beam), so the updating engine can replace them; effects that a generic element cannot hold
-(geometric stiffness of an axial load, a Winkler foundation, support springs) are kept apart
-as extra terms.  Global DOFs are node-major: a beam node i has ``w`` at 2i and θ at 2i+1
-(physical rotation in rad), a bar node i has ``u`` at i.
+(geometric stiffness of an axial load, a Winkler foundation, springs) are kept apart as extra
+terms.  Global DOFs are node-major: a beam node i has ``w`` at 2i and θ at 2i+1 (physical
+rotation in rad), a bar node i has ``u`` at i.
+
+Effects do not touch matrices themselves: each tells a :class:`Builder` what it changes
+(:meth:`~gfe_opt.effects.EffectType.contribute`), and the builder makes the elements:
+
+* EI(x) (bar: EA(x)) = EI · Π f_i(x) over the rigidity factors; an element where the
+  product differs from 1 gets the exact static stiffness of its varying rigidity
+  (:func:`~gfe_opt.elements.flexibility_parameters`, Gauss points graded towards kinks);
+* ρA(x) = ρA · Π g_i(x): the element mass gains ∫ ρA (g − 1) N Nᵀ dx (Hermite or linear N);
+* shear (Timoshenko), element stiffness terms per unit length, point masses and springs
+  (through the shape functions at their position), rotational end springs (a clamped end's
+  rotation is released and held by the spring instead).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -136,113 +148,218 @@ def constrained_dofs(model: Model) -> np.ndarray:
     return np.array(sorted(fixed), dtype=int)
 
 
-def _mass_elements(model: Model, L: float) -> np.ndarray:
-    n = model.elements
-    rho_a = model.mass_per_length
-    if model.kind == "bar":
-        beta = el.BAR_MASS_BETA[model.mass_model]
-        return el.generic_bar_mass(np.full(n, rho_a), L, np.full(n, beta))
-    shear = model.effects_named("shear")
-    if shear:
-        g = el.shear_parameter(model.bending_rigidity, shear[0].parameters["shear_rigidity"], L)
-        _, mass_params = el.timoshenko_parameters(model.bending_rigidity,
-                                                  shear[0].parameters["shear_rigidity"], L)
-    else:
-        g = 0.0
-        mass_params = {"consistent": el.CONSISTENT_BEAM_MASS,
-                       "higher_order": el.HIGHER_ORDER_BEAM_MASS}[model.mass_model]
-    scaled = rho_a * L * el.symmetric_beam_mass(**{k: np.full(n, v)
-                                                   for k, v in mass_params.items()})
-    if shear:
-        scaled = scaled + el.timoshenko_rotary_inertia(
-            np.full(n, model.rho * model.inertia), L, np.full(n, g))
-    t = el.beam_dof_scaling(L)
-    return scaled * (t[:, None] * t[None, :])
+@dataclass(frozen=True)
+class Factor:
+    """A multiplier f(x) of the rigidity or of the mass per length; f = 1 outside
+    ``support`` (``None``: anywhere).  ``breakpoints`` are kinks or jumps that element
+    quadrature must not straddle; ``refine_scale`` grades the points towards them."""
+
+    fn: Callable
+    breakpoints: tuple = ()
+    refine_scale: float | None = None
+    support: tuple | None = None
 
 
-def slope_gram(L: float) -> np.ndarray:
-    r""":math:`\int N' N'^T dx` of the Hermite element in scaled DOFs (geometric stiffness)."""
-    return el.timoshenko_rotary_inertia(1.0, L, 0.0)
+#: Gauss points per element where a factor is smooth
+GAUSS_ORDER = 8
 
 
-def crack_element_parameters(model: Model, element_stiffness) -> dict:
-    """Generic parameters of every element of a cracked beam.
+@dataclass
+class Builder:
+    """What the effects of a model change; :meth:`discretisation` makes the elements."""
 
-    EI(x) = EI Π_c Q_c(x) (Christides–Barr, eq. 25); ``element_stiffness`` is
-    :func:`~gfe_opt.elements.beam_stiffness_from_flexibility` (the models) or
-    :func:`~gfe_opt.elements.beam_stiffness_from_rigidity` (independent references).
-    """
-    cracks = model.effects_named("crack")
-    EI, L = model.bending_rigidity, model.element_length
-    half_depth = model.depth / 2.0
+    model: Model
+    rigidity: list = field(default_factory=list)
+    mass: list = field(default_factory=list)
+    shear_rigidity: float | None = None
+    element_terms: list = field(default_factory=list)
+    point_stiffness: list = field(default_factory=list)
+    point_masses: list = field(default_factory=list)
+    end_springs: list = field(default_factory=list)
 
-    def rigidity(x):
-        q = np.ones_like(x)
-        for c in cracks:
-            q = q * el.christides_barr_q(x, c.parameters["position"],
-                                         c.parameters["depth_ratio"], half_depth)
-        return EI * q
+    # -- what effects call --------------------------------------------------------------
+    def scale_rigidity(self, fn, breakpoints=(), refine_scale=None, support=None) -> None:
+        """EI(x) (bar: EA(x)) is multiplied by ``fn(x)`` (vectorised)."""
+        self.rigidity.append(Factor(fn, tuple(breakpoints), refine_scale, support))
 
-    positions = np.array([c.parameters["position"] for c in cracks])
-    decay = half_depth / (2.0 * el.SHEN_PIERRE_GAMMA)
-    k = np.tile(list(el.euler_bernoulli_stiffness(EI).values()), (model.elements, 1))
-    for e in range(model.elements):
-        # beyond 18 decay lengths Q differs from 1 by less than 26 e^-36 (~1e-14)
-        gap = np.maximum(np.maximum(e * L - positions, positions - (e + 1) * L), 0.0)
-        if np.min(gap) < 18 * decay:
-            k[e] = element_stiffness(rigidity, e * L, L, positions, decay)
-    return {"k_ww": k[:, 0], "k_wt": k[:, 1], "k_tt": k[:, 2]}
+    def scale_mass(self, fn, breakpoints=(), refine_scale=None, support=None) -> None:
+        """ρA(x) is multiplied by ``fn(x)``."""
+        self.mass.append(Factor(fn, tuple(breakpoints), refine_scale, support))
+
+    def add_element_stiffness(self, per_element: Callable) -> None:
+        """``per_element(L)`` is a (4, 4) stiffness in the scaled DOFs [w, Lθ, w, Lθ],
+        the same for every element (axial load, foundation)."""
+        self.element_terms.append(per_element)
+
+    def add_point_stiffness(self, x: float, k: float) -> None:
+        """A translational (bar: axial) spring to ground at x [m], k [N/m]."""
+        self.point_stiffness.append((float(x), float(k)))
+
+    def add_point_mass(self, x: float, m: float) -> None:
+        """A mass m [kg] at x [m] (translation only)."""
+        self.point_masses.append((float(x), float(m)))
+
+    def add_end_spring(self, side: str, k: float) -> None:
+        """A rotational spring k [N m/rad] at the ``"left"`` or ``"right"`` end."""
+        self.end_springs.append((side, float(k)))
+
+    # -- the elements -------------------------------------------------------------------
+    def discretisation(self) -> "Discretisation":
+        model = self.model
+        n, L = model.elements, model.element_length
+        beam = model.kind == "beam"
+        size = 4 if beam else 2
+        E = model.youngs_modulus
+        rigidity = E * (model.inertia if beam else model.area)
+        params = self._stiffness(rigidity)
+        mass = self._mass(E)
+        constrained = set(constrained_dofs(model).tolist())
+        extra = np.zeros((n, size, size))
+        tt = np.outer(*(2 * [el.beam_dof_scaling(L)])) if beam else np.ones((2, 2))
+        for term in self.element_terms:
+            extra = extra + term(L) * tt
+        for x, k in self.point_stiffness:
+            e, shape = self._shape_at(x)
+            extra[e] += k * np.outer(shape, shape)
+        for x, m in self.point_masses:
+            e, shape = self._shape_at(x)
+            mass[e] += m * np.outer(shape, shape)
+        nodal = []
+        for side, k in self.end_springs:
+            node = 0 if side == "left" else n
+            dof = 2 * node + 1
+            constrained.discard(dof)  # a clamp that gives: the spring replaces the fixity
+            nodal.append((dof, k))
+        scale = rigidity / (model.mass_per_length * model.length ** (4 if beam else 2))
+        return Discretisation(kind=model.kind, nodes=model.nodes, element_length=L,
+                              stiffness_params=params, mass=mass, extra_stiffness=extra,
+                              nodal_stiffness=tuple(nodal),
+                              constrained=np.array(sorted(constrained), dtype=int),
+                              eigenvalue_scale=scale)
+
+    def _shape_at(self, x):
+        """Element index and shape functions (physical DOFs) at position x."""
+        n, L = self.model.elements, self.model.element_length
+        e = min(int(x // L), n - 1)
+        xi = x / L - e
+        if self.model.kind == "beam":
+            return e, el.hermite(xi) * el.beam_dof_scaling(L)
+        return e, el.linear(xi)
+
+    def _stiffness(self, rigidity: float) -> dict:
+        model = self.model
+        n, L = model.elements, model.element_length
+        if model.kind == "bar":
+            k = np.full(n, rigidity)
+            for elements, _, w, x in _quadrature(model, self.rigidity):
+                k[elements] = L / np.sum(w / (rigidity * _product(self.rigidity, x)), axis=-1)
+            return {"k": k}
+        out = {k: np.full(n, v) for k, v in el.euler_bernoulli_stiffness(rigidity).items()}
+        for elements, s, w, x in _quadrature(model, self.rigidity):
+            c = w / (rigidity * _product(self.rigidity, x))
+            k_ww, k_wt, k_tt = el.flexibility_parameters(s, c, L)
+            out["k_ww"][elements], out["k_wt"][elements], out["k_tt"][elements] = (
+                k_ww, k_wt, k_tt)
+        if self.shear_rigidity is not None:
+            g = el.shear_parameter(out["k_ww"] / 12.0, self.shear_rigidity, L)
+            out = el.timoshenko_correction(out, g)
+        return out
+
+    def _mass(self, E: float) -> np.ndarray:
+        model = self.model
+        n, L = model.elements, model.element_length
+        rho_a = model.mass_per_length
+        if model.kind == "bar":
+            beta = el.BAR_MASS_BETA[model.mass_model]
+            mass = el.generic_bar_mass(np.full(n, rho_a), L, np.full(n, beta))
+            shape, scaling = el.linear, np.ones(2)
+        else:
+            if self.shear_rigidity is not None:
+                ei = E * model.inertia
+                g = el.shear_parameter(ei, self.shear_rigidity, L)
+                _, mass_params = el.timoshenko_parameters(ei, self.shear_rigidity, L)
+            else:
+                g = 0.0
+                mass_params = {"consistent": el.CONSISTENT_BEAM_MASS,
+                               "higher_order": el.HIGHER_ORDER_BEAM_MASS}[model.mass_model]
+            scaled = rho_a * L * el.symmetric_beam_mass(**{k: np.full(n, v)
+                                                           for k, v in mass_params.items()})
+            if self.shear_rigidity is not None:
+                scaled = scaled + el.timoshenko_rotary_inertia(
+                    np.full(n, model.rho * model.inertia), L, np.full(n, g))
+            scaling = el.beam_dof_scaling(L)
+            mass = scaled * np.outer(scaling, scaling)
+            shape = el.hermite
+        for elements, s, w, x in _quadrature(model, self.mass):
+            N = shape(s / L) * scaling
+            change = rho_a * w * (_product(self.mass, x) - 1.0)
+            mass[elements] += np.einsum("...q,...qi,...qj->...ij", change, N, N)
+        return mass
 
 
-def _beam_stiffness_params(model: Model, L: float) -> dict:
-    if model.effects_named("crack"):
-        out = crack_element_parameters(model, el.beam_stiffness_from_flexibility)
-    else:
-        out = {k: np.full(model.elements, v)
-               for k, v in el.euler_bernoulli_stiffness(model.bending_rigidity).items()}
-    shear = model.effects_named("shear")
-    if shear:
-        g = el.shear_parameter(out["k_ww"] / 12.0, shear[0].parameters["shear_rigidity"], L)
-        out = el.timoshenko_correction(out, g)
+def _product(factors, x):
+    out = np.ones_like(x)
+    for f in factors:
+        out = out * f.fn(x)
     return out
+
+
+def _quadrature(model: Model, factors):
+    """Quadrature on the elements the factors change: yields ``(elements, s, w, x)`` with
+    local coordinates s, weights w and positions x (last axis: points); elements next to a
+    breakpoint one at a time (graded points), the others together (Gauss)."""
+    if not factors:
+        return
+    n, L = model.elements, model.element_length
+    affected = np.zeros(n, dtype=bool)
+    for f in factors:
+        if f.support is None:
+            affected[:] = True
+        else:
+            lo = max(int(np.floor(f.support[0] / L)), 0)
+            hi = min(int(np.ceil(f.support[1] / L)), n)
+            affected[lo:hi] = True
+    near = np.zeros(n, dtype=bool)
+    kinks = [(b, f.refine_scale) for f in factors for b in f.breakpoints]
+    x0 = np.arange(n) * L
+    for b, r in kinks:
+        reach = 32.0 * r if r else 0.0
+        near |= (x0 - reach < b) & (b < x0 + L + reach)
+    near &= affected
+    plain = np.flatnonzero(affected & ~near)
+    if plain.size:
+        g, w = el._gauss_legendre(GAUSS_ORDER)
+        s = 0.5 * L * (g + 1.0)
+        yield plain, np.broadcast_to(s, (plain.size, s.size)), np.broadcast_to(
+            0.5 * L * w, (plain.size, s.size)), x0[plain, None] + s[None, :]
+    for e in np.flatnonzero(near):
+        points = [b for b, r in kinks if x0[e] - 32.0 * (r or 0.0) < b < x0[e] + L
+                  + 32.0 * (r or 0.0)]
+        scales = [r for b, r in kinks if r and b in points]
+        x, w = el.element_quadrature(x0[e], x0[e] + L, points,
+                                     min(scales) if scales else None)
+        yield np.array([e]), (x - x0[e])[None, :], w[None, :], x[None, :]
+
+
+def builder(model: Model) -> Builder:
+    """A :class:`Builder` told by each effect of ``model`` what it changes."""
+    from .effects import effect_type
+
+    build = Builder(model)
+    for effect in model.effects:
+        effect_type(effect.name).contribute(model, effect.parameters, build)
+    return build
 
 
 def discretise(model: Model) -> Discretisation:
     """Element data of ``model`` including its effects."""
-    n, L = model.elements, model.element_length
-    nodes = model.nodes
-    size = 2 * (2 if model.kind == "beam" else 1)
-    extra = np.zeros((n, size, size))
-    nodal = []
-    mass = _mass_elements(model, L)
-    if model.kind == "bar":
-        params = {"k": np.full(n, model.axial_rigidity)}
-        scale = model.axial_rigidity / (model.mass_per_length * model.length**2)
-    else:
-        params = _beam_stiffness_params(model, L)
-        scale = model.bending_rigidity / (model.mass_per_length * model.length**4)
-        t = el.beam_dof_scaling(L)
-        tt = t[:, None] * t[None, :]
-        for eff in model.effects_named("axial_load"):
-            extra = extra + eff.parameters["tension"] * slope_gram(L) * tt
-        for eff in model.effects_named("foundation"):
-            found = eff.parameters["stiffness"] * L * el.symmetric_beam_mass(
-                **el.CONSISTENT_BEAM_MASS)
-            extra = extra + found * tt
-        for eff in model.effects_named("support_spring"):
-            side = eff.parameters["side"]
-            ends = {"left": [0], "right": [n], "both": [0, n]}[side]
-            nodal += [(2 * node + 1, eff.parameters["stiffness"]) for node in ends]
-    for eff in model.effects_named("point_mass"):
-        e = min(int(eff.parameters["position"] // L), n - 1)
-        xi = eff.parameters["position"] / L - e
-        if model.kind == "beam":
-            shape = el.hermite(xi) * el.beam_dof_scaling(L)
-        else:
-            shape = el.linear(xi)
-        mass = mass.copy()
-        mass[e] += eff.parameters["mass"] * np.outer(shape, shape)
-    return Discretisation(kind=model.kind, nodes=nodes, element_length=L,
-                          stiffness_params=params, mass=mass, extra_stiffness=extra,
-                          nodal_stiffness=tuple(nodal), constrained=constrained_dofs(model),
-                          eigenvalue_scale=scale)
+    return builder(model).discretisation()
+
+
+def rigidity_function(model: Model):
+    """EI(x) (bar: EA(x)) of the model with its effects, as a vectorised function, and the
+    breakpoints of its factors (for references that integrate it another way)."""
+    build = builder(model)
+    base = model.youngs_modulus * (model.inertia if model.kind == "beam" else model.area)
+    return (lambda x: base * _product(build.rigidity, np.asarray(x, float)),
+            tuple(b for f in build.rigidity for b in f.breakpoints))

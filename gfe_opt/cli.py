@@ -13,14 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .correlation import DEFAULT_MAC_THRESHOLD, DEFAULT_SHAPE_NOISE, Comparison, compare
-from .diagnosis import CANDIDATES, DEFAULT_FREQ_NOISE
-from .diagnosis import DEFAULT_SHAPE_NOISE as DEFAULT_DIAG_SHAPE_NOISE
+from .correlation import DEFAULT_MAC_THRESHOLD, DEFAULT_SHAPE_NOISE, compare
+from .effects import EFFECTS
 from .errors import GfeInputError, GfeSolverError
+from .fitting import DEFAULT_FREQ_NOISE
+from .fitting import DEFAULT_SHAPE_NOISE as DEFAULT_FIT_SHAPE_NOISE
 from .measured import check_output_path, load_measured
 from .model import load_model
-
-SPARK = " ▁▂▃▄▅▆▇█"
+from .text import format_comparison, format_diagnosis, format_update, terminal_progress
 
 
 def _fraction(text: str) -> float:
@@ -30,6 +30,17 @@ def _fraction(text: str) -> float:
         raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
     if not 0.0 <= value < 1.0:
         raise argparse.ArgumentTypeError(f"must lie in [0, 1), got {text}")
+    return value
+
+
+def _noise(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"must lie between 0 and 1 (relative, e.g. 0.003 "
+                                         f"for 0.3 %%), got {text}")
     return value
 
 
@@ -67,18 +78,21 @@ def build_parser() -> argparse.ArgumentParser:
     output_options(p)
 
     def noise_options(p):
-        p.add_argument("--freq-noise", type=_fraction, default=DEFAULT_FREQ_NOISE,
-                       help="relative frequency noise σ_f (default %(default)s)")
-        p.add_argument("--shape-noise", type=_fraction, default=DEFAULT_DIAG_SHAPE_NOISE,
-                       help="shape noise σ_s relative to each mode's largest amplitude "
-                            "(default %(default)s)")
+        p.add_argument("--freq-noise", type=_noise, default=None,
+                       help="relative frequency noise σ_f of the test (not given: "
+                            f"{DEFAULT_FREQ_NOISE} is assumed and the data's own level is "
+                            "estimated and reported)")
+        p.add_argument("--shape-noise", type=_noise, default=None,
+                       help="shape noise σ_s relative to each mode's largest amplitude (not "
+                            f"given: {DEFAULT_FIT_SHAPE_NOISE} is assumed and estimated)")
 
-    g = sub.add_parser("diagnose", help="rank the physical effects that explain the error")
+    g = sub.add_parser("diagnose", help="which physical effect is missing (or none)")
     g.add_argument("model", help="model file (.toml)")
     g.add_argument("measured", help="measured modes (.json, .csv, .uff, .unv)")
     g.add_argument("--json", action="store_true", help="print the result as JSON")
-    g.add_argument("--candidates", default=",".join(CANDIDATES),
-                   help="comma-separated effects to try (default: all)")
+    g.add_argument("--candidates", default=None, metavar="NAME,...",
+                   help="comma-separated effects to try (default: every one that applies; "
+                        f"known: {', '.join(EFFECTS)})")
     noise_options(g)
     output_options(g)
 
@@ -86,7 +100,9 @@ def build_parser() -> argparse.ArgumentParser:
     u.add_argument("model", help="model file (.toml)")
     u.add_argument("measured", help="measured modes (.json, .csv, .uff, .unv)")
     u.add_argument("--add", action="append", required=True, metavar="EFFECT",
-                   help="effect to add, e.g. crack or crack:position=0.2 (repeatable)")
+                   help="effect instance to add, e.g. crack or crack:position=0.2 "
+                        "(repeatable; local effects may be added several times; known: "
+                        f"{', '.join(EFFECTS)})")
     u.add_argument("--out", help="write the updated model (with its [[effects]]) here")
     u.add_argument("--json", action="store_true", help="print the result as JSON")
     noise_options(u)
@@ -103,37 +119,6 @@ def build_parser() -> argparse.ArgumentParser:
                    help="folder for the demo's files (default %(default)s)")
     d.add_argument("--force", action="store_true", help="overwrite the demo's own files")
     return parser
-
-
-def format_comparison(result: Comparison, length: float) -> str:
-    """Readable table of paired modes and the localisation summary."""
-    lines = [f"{'mode':>4}  {'f_test [Hz]':>12}  {'f_model [Hz]':>12}  {'Δf %':>8}  {'MAC':>6}"]
-    for p in result.pairs:
-        model = f"{p.model_hz:12.2f}"
-        lines.append(f"{p.test_mode:>4}  {p.test_hz:12.2f}  {model}  {p.error_pct:+8.2f}  "
-                     f"{p.mac:6.3f}")
-    for t in result.unpaired_test_modes:
-        lines.append(f"{t + 1:>4}  (no model mode with MAC >= threshold)")
-    lines.append(f"frequency error (rms) {result.freq_error_rms_pct:.2f} %, "
-                 f"mean MAC {result.mac_mean:.3f}")
-    places = result.failure_places()
-    lines.append("")
-    if not places:
-        lines.append("no residual force: the model reproduces the measured shapes")
-        lines.extend(f"note: {n}" for n in result.notes)
-        return "\n".join(lines)
-    r = result.residual / result.residual.max()
-    spark = "".join(SPARK[int(round(v * (len(SPARK) - 1)))] for v in r)
-    lines.append("residual force along the structure (left end -> right end):")
-    lines.append(f"  |{spark}|")
-    x0, _ = places[0]
-    lines.append(f"the model fails most near x = {x0:.3f} m ({100 * x0 / length:.0f} % of the "
-                 "length)")
-    for x, rel in places[1:]:
-        lines.append(f"  also near x = {x:.3f} m ({100 * x / length:.0f} %), "
-                     f"{100 * rel:.0f} % of the largest residual")
-    lines.extend(f"note: {n}" for n in result.notes)
-    return "\n".join(lines)
 
 
 def _check_outputs(args, names) -> None:
@@ -232,61 +217,19 @@ def cmd_modes(args) -> int:
     return 0
 
 
-def _progress(enabled: bool):
-    """A one-line progress report on stderr when it is a terminal."""
-    if not (enabled and sys.stderr.isatty()):
-        return None
-
-    def report(done, total, name):
-        end = "\n" if done == total else ""
-        print(f"\rfitting candidate effects: {done}/{total} {name:<16}", end=end,
-              file=sys.stderr, flush=True)
-
-    return report
-
-
-def _format_params(params: dict) -> str:
-    return ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
-                     for k, v in params.items())
-
-
-def format_diagnosis(result, model) -> str:
-    """Readable diagnosis: ranking, verdict, and what the generic update's equations say."""
-    b = result.baseline
-    lines = [f"baseline: frequency error {b.freq_error_rms_pct:.3f} % rms, mean MAC "
-             f"{b.mac_mean:.4f}", "",
-             f"{'rank':>4}  {'effect':<15} {'f err %':>8} {'MAC':>7}  {'significant':<11} "
-             "parameters"]
-    for i, f in enumerate(result.fits, 1):
-        lines.append(f"{i:>4}  {f.effect:<15} {f.misfit.freq_error_rms_pct:8.3f} "
-                     f"{f.misfit.mac_mean:7.4f}  {'yes' if f.significant else 'no':<11} "
-                     f"{_format_params(f.parameters)}")
-    best = result.best
-    lines.append("")
-    if best is None:
-        lines.append("no candidate explains significantly more than the measurement noise")
-    else:
-        lines.append(f"most likely missing: {best.effect} ({_format_params(best.parameters)}):"
-                     f" frequency error {b.freq_error_rms_pct:.3f} % -> "
-                     f"{best.misfit.freq_error_rms_pct:.3f} %")
-    lines += [f"the generic-element update says: {t}" for t in result.realisation]
-    lines.append(f"({result.seconds:.1f} s)")
-    return "\n".join(lines)
-
-
 def cmd_diagnose(args) -> int:
     from .diagnosis import diagnose
 
     model = load_model(args.model)
     measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
-    candidates = [c.strip() for c in args.candidates.split(",") if c.strip()]
-    unknown = [c for c in candidates if c not in CANDIDATES]
-    if unknown:
-        raise GfeInputError("--candidates", unknown[0], "unknown effect (known: "
-                            f"{', '.join(CANDIDATES)})")
+    candidates = None
+    if args.candidates is not None:
+        candidates = [c.strip() for c in args.candidates.split(",") if c.strip()]
+        if not candidates:
+            raise GfeInputError("--candidates", None, "no effect named")
     _check_outputs(args, DIAGNOSIS_FIGURES)
     result = diagnose(model, measured, candidates=candidates, freq_noise=args.freq_noise,
-                      shape_noise=args.shape_noise, progress=_progress(not args.json),
+                      shape_noise=args.shape_noise, progress=terminal_progress(not args.json),
                       realise=True)
     if args.json:
         print(json.dumps(result.to_json(), indent=1))
@@ -304,8 +247,8 @@ def cmd_diagnose(args) -> int:
     return 0
 
 
-DIAGNOSIS_FIGURES = ("candidates.png", "stiffness_change.png", "slope_change.png",
-                     "disturbance.png", "nodal_equations.png")
+DIAGNOSIS_FIGURES = ("candidates.png", "stiffness_change.png", "disturbance.png",
+                     "nodal_equations.png")
 
 
 def cmd_update(args) -> int:
@@ -323,34 +266,22 @@ def cmd_update(args) -> int:
     if args.out:
         save_model(outcome.model, args.out, force=args.force,
                    protect=(args.model, args.measured))
+    if args.json:
+        print(json.dumps(outcome.to_json(), indent=1))
+    else:
+        print(format_update(outcome))
+        if args.out:
+            print(f"updated model written to {args.out}; continue with: gfe-opt diagnose "
+                  f"{args.out} {args.measured}")
     if args.plot or args.report:
         from .report import update_figures
 
         def body(report):
             report.heading("Update")
-            report.table(["", "frequency error [% rms]", "mean MAC"],
-                         [["before", f"{outcome.before.freq_error_rms_pct:.3f}",
-                           f"{outcome.before.mac_mean:.4f}"],
-                          ["after", f"{outcome.after.freq_error_rms_pct:.3f}",
-                           f"{outcome.after.mac_mean:.4f}"]])
-            report.table(["effect", "parameters"],
-                         [[e.name, _format_params(e.parameters)]
-                          for e in outcome.model.effects])
+            report.preformatted(format_update(outcome))
 
         _write_outputs(args, _figures(update_figures, outcome), body,
                        f"gfe-opt update: {model.name}")
-    if args.json:
-        print(json.dumps(outcome.to_json(), indent=1))
-        return 0
-    print(f"before: frequency error {outcome.before.freq_error_rms_pct:.3f} % rms, "
-          f"mean MAC {outcome.before.mac_mean:.4f}")
-    for e in outcome.model.effects:
-        print(f"  fitted {e.name}: {_format_params(e.parameters)}")
-    print(f"after:  frequency error {outcome.after.freq_error_rms_pct:.3f} % rms, "
-          f"mean MAC {outcome.after.mac_mean:.4f}")
-    if args.out:
-        print(f"updated model written to {args.out}; continue with: gfe-opt diagnose "
-              f"{args.out} {args.measured}")
     return 0
 
 

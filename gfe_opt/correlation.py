@@ -53,13 +53,25 @@ def mac(a, b) -> np.ndarray:
     return num / den
 
 
-def pair_modes(mac_matrix, threshold: float = DEFAULT_MAC_THRESHOLD) -> list[tuple[int, int]]:
+#: weight of |ln(f_model / f_test)| against MAC in the pairing: it only breaks near-ties
+#: (a Timoshenko beam's thickness-shear mode has the deflection shape of a bending mode)
+FREQUENCY_TIE_BREAK = 0.05
+
+
+def pair_modes(mac_matrix, threshold: float = DEFAULT_MAC_THRESHOLD, test_hz=None,
+               model_hz=None) -> list[tuple[int, int]]:
     """Pair test modes (rows) with model modes (columns) by MAC, not by index.
 
-    A one-to-one assignment maximising the total MAC (Hungarian algorithm); pairs whose MAC
-    is below ``threshold`` are dropped, so a test mode the model lacks stays unpaired.
+    A one-to-one assignment maximising the total MAC (Hungarian algorithm), near-ties broken
+    by the frequency ratio when the frequencies are given; pairs whose MAC is below
+    ``threshold`` are dropped, so a test mode the model lacks stays unpaired.
     """
-    rows, cols = linear_sum_assignment(-np.asarray(mac_matrix))
+    cost = -np.asarray(mac_matrix, dtype=float)
+    if test_hz is not None and model_hz is not None:
+        ratio = np.abs(np.log(np.maximum(np.asarray(model_hz), 1e-300)[None, :]
+                              / np.asarray(test_hz)[:, None]))
+        cost = cost + FREQUENCY_TIE_BREAK * np.minimum(ratio, 10.0)
+    rows, cols = linear_sum_assignment(cost)
     keep = mac_matrix[rows, cols] >= threshold
     return sorted(zip(rows[keep].tolist(), cols[keep].tolist()))
 
@@ -242,7 +254,8 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
     check_frequency_units(measured, modes.frequencies_hz)
     at_sensors = C @ modes.shapes
     mac_matrix = mac(measured.shapes, at_sensors)
-    pairs_idx = pair_modes(mac_matrix, mac_threshold)
+    pairs_idx = pair_modes(mac_matrix, mac_threshold, measured.frequencies_hz,
+                           modes.frequencies_hz)
     pairs = [Pair(test_mode=t + 1, model_mode=m + 1,
                   test_hz=float(measured.frequencies_hz[t]),
                   model_hz=float(modes.frequencies_hz[m]),

@@ -5,7 +5,6 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from .cli import _format_params, _progress, format_comparison, format_diagnosis
 from .correlation import compare
 from .diagnosis import diagnose, update
 from .errors import GfeInputError
@@ -15,9 +14,18 @@ from .plots import error_history
 from .problems import problem_file
 from .report import Report, compare_figures, diagnosis_figures, save_figures
 from .synthetic import interior_sensors, synthetic_measurement
+from .text import (
+    format_comparison,
+    format_diagnosis,
+    format_parameters,
+    format_update,
+    terminal_progress,
+)
 
 #: The hidden truth of the demo: a crack the starting model does not have.
 DEMO_CRACK = {"position": 0.19, "depth_ratio": 0.5}
+#: The noise the demo's test is simulated with, stated to the diagnosis.
+NOISE = {"freq_noise": 0.0005, "shape_noise": 0.003}
 
 
 def _indent(text: str) -> str:
@@ -53,7 +61,8 @@ def run_demo(out: Path, force: bool = False) -> int:
     print("\n4. Diagnose: each candidate physical effect is fitted (IPOPT) and ranked by how "
           "much of\n   the error it explains; 'significant' means beyond the measurement "
           "noise.\n")
-    diagnosis = diagnose(model, measured, realise=True, progress=_progress(True))
+    diagnosis = diagnose(model, measured, realise=True, progress=terminal_progress(True),
+                         **NOISE)
     print(_indent(format_diagnosis(diagnosis, model)))
     best = diagnosis.best
     if best is None:
@@ -61,20 +70,16 @@ def run_demo(out: Path, force: bool = False) -> int:
         return 0
     print(f"\n5. Add it: update --add {best.effect} fits its parameters, starting from the "
           "diagnosis.\n")
-    outcome = update(model, measured, [best.effect])
+    outcome = update(model, measured, [best.effect], **NOISE)
     save_model(outcome.model, updated_path, force=True, protect=(model_path, measured_path))
-    for e in outcome.model.effects:
-        print(f"   fitted {e.name}: {_format_params(e.parameters)}")
-    print(f"   frequency error {outcome.before.freq_error_rms_pct:.3f} % -> "
-          f"{outcome.after.freq_error_rms_pct:.3f} % (noise 0.05 %), mean MAC "
-          f"{outcome.before.mac_mean:.4f} -> {outcome.after.mac_mean:.4f}")
+    print(_indent(format_update(outcome)))
     print(f"   the hidden truth was: crack at x = {DEMO_CRACK['position']} m, "
           f"a/d = {DEMO_CRACK['depth_ratio']}")
     print("\n6. Check: diagnose the updated model; nothing significant should be left.\n")
-    again = diagnose(outcome.model, measured, progress=_progress(True))
+    again = diagnose(outcome.model, measured, progress=terminal_progress(True), **NOISE)
     left = again.best
-    print("   nothing significant is left" if left is None else
-          f"   still significant: {left.effect} ({_format_params(left.parameters)})")
+    print("   nothing significant is left: " + again.verdict if left is None else
+          f"   still significant: {left.describe()}")
     try:
         figures = {**compare_figures(result, model), **diagnosis_figures(diagnosis, model),
                    "error.png": error_history([
@@ -113,7 +118,7 @@ def _write_report(out, report_path, figures, result, diagnosis, outcome, best, m
                   ["after", f"{outcome.after.freq_error_rms_pct:.3f}",
                    f"{outcome.after.mac_mean:.4f}"]])
     report.table(["effect", "fitted parameters", "hidden truth"],
-                 [[e.name, _format_params(e.parameters), _format_params(DEMO_CRACK)]
+                 [[e.name, format_parameters(e.parameters), format_parameters(DEMO_CRACK)]
                   for e in outcome.model.effects])
     for name, fig in figures.items():
         report.figure(fig, name.removesuffix(".png").replace("_", " "))

@@ -1,32 +1,50 @@
-r"""Diagnosis and update with physical effects: which effect is missing, and its parameters.
+r"""Diagnosis: which physical effect is missing, here, this big, ± this much — or that the
+model agrees with the test, or that nothing the tool knows explains it.
 
-Misfit
-------
-For a model, the lowest modes are paired with the measured ones by MAC (Hungarian,
-threshold 0.3) and the weighted residual is
+Candidates
+----------
+Every registered effect that applies to the model (:func:`~gfe_opt.effects.candidate_names`)
+is fitted together with the model's present effects, which are re-estimated from where they
+are (:func:`~gfe_opt.fitting.fit_effects`).  A global effect already present is not proposed
+again; a local one (a crack, a point mass, ...) is proposed as a further instance.  Each
+candidate tries its own starting points (a grid, where the model fails, each side of a
+support spring) and keeps the best.
 
-.. math:: χ^2 = \sum_j \Big(\frac{f_j/f_{t,j} - 1}{σ_f}\Big)^2
-        + \sum_j \sum_s \Big(\frac{\hat φ_{sj} - \hat y_{sj}}{σ_s \max_s|\hat y_{sj}|}\Big)^2
+Significance (model selection that survives model error)
+--------------------------------------------------------
+χ² is in units of the stated (or assumed) noise.  Discretisation error and unmodelled physics
+make it larger than the noise, and then any extra parameter "helps", so every test is made
+against the **noise floor** :math:`s^2 = \max(1, \min_f χ^2_f/(n - p_f))`, the residual
+variance of the most flexible fit reached.  A candidate adding p parameters is significant
+when
 
-with unit-norm, sign-aligned shapes at the sensors, σ_f the relative frequency noise and
-σ_s the shape noise relative to each mode's largest amplitude (defaults 0.05 % and 0.3 %).
-A measured mode with no partner costs :math:`(0.5/σ_f)^2`.
+1. it lowers χ² against the present effects re-estimated by more than
+   :math:`s^2\,χ^2_{p}(1-α')`, with α = 10⁻³ divided by the number of candidates and, for an
+   effect with a position, by the 2m + 1 places that m modes can tell apart (a scan over the
+   structure finds a good-looking place by chance: the look-elsewhere effect);
+2. its size is determined: it lies at least 3 standard deviations from "no effect" (a mass
+   on a pinned support, a spring of no effect never are);
+3. for effects other than ``material``: it explains more than the best uniform change of E
+   by the same margin (a uniform change is not called a crack).
 
-Fitting (IPOPT)
----------------
-Each candidate's physical parameters are mapped to order-one variables with bounds (e.g. a
-crack's position / length and depth ratio, tension / Euler load, log10 of a spring's
-stiffness / (EI/ℓ)), started from the best point of a coarse grid (the crack and the point
-mass also from the localisation of :func:`~gfe_opt.correlation.compare`), and χ² is
-minimised by IPOPT through CasADi with central finite-difference gradients and a
-limited-memory Hessian.  Effects already in the model are re-estimated with the candidate.
+Candidates are ranked by χ² plus their own threshold (the simpler effect wins a tie).
 
-Significance
-------------
-An effect is significant when it lowers χ² by more than the 99.9 % quantile of
-χ²(p) (p its number of parameters) against the model without it *and*, for effects other
-than ``material``, against the best material-only fit: a uniform change is not reported as a
-crack.  ``support_spring`` tries ``left``, ``right`` and ``both`` and keeps the best.
+Named effects first, profiles when nothing named suffices
+---------------------------------------------------------
+When the best named effect does not bring χ² within the stated noise, the
+``stiffness_profile`` (EI piecewise linear on 2, 3, 5, 9 knots, started from the paper's
+generic-element update with the nodal parameterisation and fitted with the same misfit) is
+fitted too (and ``mass_profile`` when that is not enough).  If the profile is significantly
+better than the named effect, the named effect is kept only when it and one more effect (the
+next candidates, or a further instance of itself) explain the data as well as the profile;
+otherwise the profile is the finding.  Profiles count all their knots as parameters.
+
+Verdict
+-------
+``effect_found`` (the first entry is significant), ``consistent`` (nothing significant and
+χ² within the 99.9 % range of the stated noise; or, with no noise given, residuals that look
+like noise: uncorrelated from sensor to sensor), ``unexplained`` (nothing significant and the
+model does not fit to the noise).  The noise the data imply is always stated.
 """
 
 from __future__ import annotations
@@ -38,525 +56,251 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 
-import casadi as ca
 import numpy as np
 from scipy.special import chdtri
 
-from .correlation import compare, mac, pair_modes
+from .correlation import compare
+from .effects import candidate_names, effect_type
+from .effects.profile import KNOT_COUNTS
 from .errors import GfeInputError, GfeSolverError
+from .fitting import (
+    DEFAULT_FREQ_NOISE,
+    DEFAULT_SHAPE_NOISE,
+    Fit,
+    Misfit,
+    Noise,
+    fit_effects,
+    jsonable,
+    misfit,
+    noise_of,
+    slots_for,
+)
 from .measured import MeasuredModes, sensor_matrix
-from .modal import model_modes
-from .model import EFFECT_PARAMETERS, Effect, Model, validate_effect
+from .model import Effect, Model, check_repeats, validate_effect
 
-DEFAULT_FREQ_NOISE = 0.0005
-DEFAULT_SHAPE_NOISE = 0.003
+__all__ = ["DEFAULT_FREQ_NOISE", "DEFAULT_SHAPE_NOISE", "Diagnosis", "UpdateOutcome",
+           "diagnose", "parse_effect", "update"]
+
 SIGNIFICANCE_LEVEL = 0.999
-CANDIDATES = ("material", "crack", "shear", "axial_load", "foundation", "support_spring",
-              "point_mass")
+#: a significant effect lies this many standard deviations from "no effect"
+SIZE_SIGMAS = 3.0
+#: residuals correlated more than this from sensor to sensor are model error, not noise
+WHITE_NOISE_CORRELATION = 0.3
+#: frequencies off by more than this many times the assumed noise are not noise
+FREQ_NOISE_LIMIT = 4.0
+VERDICTS = ("consistent", "effect_found", "unexplained")
 
 
-# -------------------------------------------------------------------------------------------
-# Misfit
-# -------------------------------------------------------------------------------------------
+def quantile(p: int, alpha: float) -> float:
+    """Upper α quantile of χ²(p)."""
+    return float(chdtri(max(int(p), 1), alpha))
 
 
-@dataclass(frozen=True)
-class Misfit:
-    """χ² of a model against measured modes, with the summary numbers users read."""
-
-    chi2: float
-    freq_error_rms_pct: float
-    mac_mean: float
-    n_residuals: int
+def fits_noise(m: Misfit, n_params: int, scale: float = 1.0) -> bool:
+    """χ² within the 99.9 % range of ``scale`` × the stated noise."""
+    dof = max(m.n_residuals - n_params, 1)
+    return m.chi2 <= scale * quantile(dof, 1.0 - SIGNIFICANCE_LEVEL)
 
 
-def misfit(model: Model, measured: MeasuredModes, freq_noise=DEFAULT_FREQ_NOISE,
-           shape_noise=DEFAULT_SHAPE_NOISE, C=None) -> Misfit:
-    """Weighted residual of ``model`` against ``measured`` (see module docstring)."""
-    r, f_err, macs = _residuals(model, measured, freq_noise, shape_noise, C)
+def shape_correlation(model: Model, measured: MeasuredModes, noise: Noise, C=None) -> float:
+    """Correlation of the shape residuals of neighbouring sensors (ordered along the
+    structure), pooled over modes: about 0 for noise, near 1 for a model error."""
+    from .fitting import residuals
+
+    r = residuals(model, measured, noise, C)[0]
     if r is None:
-        return Misfit(np.inf, np.inf, 0.0, 0)
-    return Misfit(chi2=float(np.sum(r**2)),
-                  freq_error_rms_pct=float(100 * np.sqrt(np.mean(f_err**2))) if f_err.size
-                  else float("inf"),
-                  mac_mean=float(np.mean(macs)) if macs.size else 0.0, n_residuals=r.size)
-
-
-def _residuals(model, measured, freq_noise, shape_noise, C=None):
-    """Fixed-length residual vector (per measured mode: frequency, then sensors), the
-    relative frequency errors and MACs of the pairs; ``(None, ...)`` if the solve fails."""
-    n_model = measured.n_modes + 4
-    try:
-        modes = model_modes(model, n_model)
-    except GfeSolverError:
-        return None, np.zeros(0), np.zeros(0)
-    if C is None:
-        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
-    shapes = C @ modes.shapes
-    mac_matrix = mac(measured.shapes, shapes)
-    pairs = pair_modes(mac_matrix, threshold=0.3)
-    rows = np.array([t for t, _ in pairs], dtype=int)
-    cols = np.array([m for _, m in pairs], dtype=int)
-    r = np.zeros((measured.n_modes, 1 + measured.n_sensors))
-    r[:, 0] = 0.5 / freq_noise  # an unpaired mode
-    f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
-    y = measured.shapes[:, rows] / np.linalg.norm(measured.shapes[:, rows], axis=0)
-    s = shapes[:, cols] / np.linalg.norm(shapes[:, cols], axis=0)
-    s = s * np.sign(np.sum(s * y, axis=0))
-    r[rows, 0] = f_err / freq_noise
-    r[rows, 1:] = ((s - y) / (shape_noise * np.max(np.abs(y), axis=0))).T
-    return r.ravel(), f_err, mac_matrix[rows, cols]
+        return 1.0
+    shapes = r.reshape(measured.n_modes, -1)[:, 1:][:, np.argsort(measured.x)]
+    if shapes.shape[1] < 3:
+        return 0.0
+    shapes = shapes - shapes.mean(axis=1, keepdims=True)
+    den = float(np.sum(shapes**2))
+    return float(np.sum(shapes[:, 1:] * shapes[:, :-1]) / den) if den > 0 else 0.0
 
 
 # -------------------------------------------------------------------------------------------
-# Parameter maps: physical parameters <-> order-one variables with bounds
-# -------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Variable:
-    name: str
-    lower: float
-    upper: float
-    grid: tuple
-
-
-def _variables(model: Model, name: str) -> list[Variable]:
-    """Order-one variables of an effect (documented in the module docstring)."""
-    if name == "material":
-        return [Variable("E", 0.5, 2.0, (0.9, 1.0, 1.1))]
-    if name == "crack":
-        return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19))),
-                Variable("depth_ratio", 0.01, 0.9, (0.2, 0.45, 0.7))]
-    if name == "shear":
-        return [Variable("shear_rigidity", -1.0, 6.0, (0.0, 1.0, 2.0, 3.0, 5.0))]
-    if name == "axial_load":
-        return [Variable("tension", -0.95, 50.0, (-0.5, 0.0, 0.5, 2.0, 8.0))]
-    if name == "foundation":
-        return [Variable("stiffness", 1e-4, 100.0, (0.05, 0.5, 2.0, 10.0))]
-    if name == "support_spring":
-        return [Variable("stiffness", -3.0, 6.0, (-1.0, 0.0, 1.0, 2.0))]
-    if name == "point_mass":
-        return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19))),
-                Variable("mass", 1e-4, 3.0, (0.05, 0.2, 0.5))]
-    raise GfeInputError(None, "effect", f"unknown effect {name!r} "
-                        f"(known: {', '.join(EFFECT_PARAMETERS)})")
-
-
-def _to_physical(model: Model, name: str, z, side: str | None = None) -> dict:
-    """Physical parameters of effect ``name`` from its order-one variables ``z``."""
-    EI, ell = model.bending_rigidity, model.length
-    if name == "material":
-        return {"E": float(z[0] * model.E)}
-    if name == "crack":
-        return {"position": float(z[0] * ell), "depth_ratio": float(z[1])}
-    if name == "shear":
-        return {"shear_rigidity": float(10.0 ** z[0] * EI / ell**2 * 100.0)}
-    if name == "axial_load":
-        return {"tension": float(z[0] * np.pi**2 * EI / ell**2)}
-    if name == "foundation":
-        return {"stiffness": float(z[0] * EI * (np.pi / ell) ** 4)}
-    if name == "support_spring":
-        return {"stiffness": float(10.0 ** z[0] * EI / ell), "side": side}
-    if name == "point_mass":
-        return {"position": float(z[0] * ell), "mass": float(z[1] * model.mass_per_length * ell)}
-    raise AssertionError(name)
-
-
-def _to_variables(model: Model, name: str, params: dict) -> np.ndarray:
-    """Inverse of :func:`_to_physical` (starting values from physical parameters)."""
-    EI, ell = model.bending_rigidity, model.length
-    table = {
-        "material": lambda p: [p["E"] / model.E],
-        "crack": lambda p: [p["position"] / ell, p["depth_ratio"]],
-        "shear": lambda p: [np.log10(p["shear_rigidity"] / (EI / ell**2 * 100.0))],
-        "axial_load": lambda p: [p["tension"] / (np.pi**2 * EI / ell**2)],
-        "foundation": lambda p: [p["stiffness"] / (EI * (np.pi / ell) ** 4)],
-        "support_spring": lambda p: [np.log10(p["stiffness"] / (EI / ell))],
-        "point_mass": lambda p: [p["position"] / ell, p["mass"] / (model.mass_per_length * ell)],
-    }
-    return np.array(table[name](params), dtype=float)
-
-
-# -------------------------------------------------------------------------------------------
-# Fitting
+# Results
 # -------------------------------------------------------------------------------------------
 
 
 @dataclass
-class Fit:
-    """A model with fitted effects and its misfit."""
+class NoiseEstimate:
+    """The stated (or assumed) noise and what the data imply (from the most flexible fit)."""
 
-    effect: str
-    parameters: dict
-    model: Model
-    misfit: Misfit
-    status: str
-    success: bool
-    evaluations: int
-    significant: bool = False
+    freq: float
+    shape: float
+    given: bool
+    implied_freq: float
+    implied_shape: float
+    floor: float
+    correlation: float
 
-
-class _Residual(ca.Callback):
-    """r(z) as a CasADi function with a forward-difference Jacobian whose own derivative is
-    zero, so IPOPT's exact-Hessian mode on ½‖r‖² performs Gauss–Newton steps."""
-
-    def __init__(self, fun, n: int, m: int, step: float = 1e-6):
-        ca.Callback.__init__(self)
-        self.fun, self.n, self.m, self.step = fun, n, m, step
-        self.construct("residual", {})
-
-    def get_n_in(self):
-        return 1
-
-    def get_n_out(self):
-        return 1
-
-    def get_sparsity_in(self, i):
-        return ca.Sparsity.dense(self.n, 1)
-
-    def get_sparsity_out(self, i):
-        return ca.Sparsity.dense(self.m, 1)
-
-    def eval(self, arg):
-        return [self.fun(np.array(arg[0]).ravel())]
-
-    def has_jacobian(self):
-        return True
-
-    def get_jacobian(self, name, inames, onames, opts):
-        self._jacobian = _ForwardDifference(name, self)
-        return self._jacobian
-
-
-class _ForwardDifference(ca.Callback):
-    def __init__(self, name, outer: _Residual):
-        ca.Callback.__init__(self)
-        self.outer = outer
-        self.construct(name, {})
-
-    def get_n_in(self):
-        return 2
-
-    def get_n_out(self):
-        return 1
-
-    def get_sparsity_in(self, i):
-        return ca.Sparsity.dense(self.outer.n if i == 0 else self.outer.m, 1)
-
-    def get_sparsity_out(self, i):
-        return ca.Sparsity.dense(self.outer.m, self.outer.n)
-
-    def eval(self, arg):
-        z, r0 = np.array(arg[0]).ravel(), np.array(arg[1]).ravel()
-        jac = np.zeros((self.outer.m, self.outer.n))
-        for k in range(self.outer.n):
-            dz = z.copy()
-            h = self.outer.step * max(1.0, abs(z[k]))
-            dz[k] += h
-            jac[:, k] = (self.outer.fun(dz) - r0) / h
-        return [jac]
-
-    def has_jacobian(self):
-        return True
-
-    def get_jacobian(self, name, inames, onames, opts):
-        self._zero = _Zero(name, self.outer.n, self.outer.m)
-        return self._zero
-
-
-class _Zero(ca.Callback):
-    """The (neglected) second derivative of the residual: Gauss–Newton."""
-
-    def __init__(self, name, n, m):
-        ca.Callback.__init__(self)
-        self.n, self.m = n, m
-        self.construct(name, {})
-
-    def get_n_in(self):
-        return 3
-
-    def get_n_out(self):
-        return 2
-
-    def get_sparsity_in(self, i):
-        return [ca.Sparsity.dense(self.n, 1), ca.Sparsity.dense(self.m, 1),
-                ca.Sparsity.dense(self.m, self.n)][i]
-
-    def get_sparsity_out(self, i):
-        return ca.Sparsity(self.m * self.n, self.n if i == 0 else self.m)
-
-    def eval(self, arg):
-        return [ca.DM(ca.Sparsity(self.m * self.n, self.n)),
-                ca.DM(ca.Sparsity(self.m * self.n, self.m))]
-
-
-def _slots(model: Model, adding: list[Effect]):
-    """Free effects: the model's present ones (re-estimated) and those being added."""
-    slots = [(e.name, e.parameters.get("side")) for e in model.effects]
-    for e in adding:
-        if e.name not in [s[0] for s in slots]:
-            slots.append((e.name, e.parameters.get("side")))
-    return slots
-
-
-def fit_effects(model: Model, measured: MeasuredModes, adding: list[Effect], *,
-                freq_noise=DEFAULT_FREQ_NOISE, shape_noise=DEFAULT_SHAPE_NOISE,
-                start: dict | None = None, max_iter: int = 25) -> Fit:
-    """Fit the physical parameters of the model's effects and of ``adding`` (IPOPT).
-
-    ``adding`` holds effects whose parameters are starting values (``Effect(name, {})`` for
-    none: then a coarse grid chooses them).  ``start`` maps effect names to known starting
-    parameters (e.g. a crack position from the localisation).
-    """
-    base = model.with_effects([])
-    slots = _slots(model, adding)
-    present = {e.name: e for e in model.effects}
-    present.update({e.name: e for e in adding if e.parameters})
-    variables = [_variables(model, name) for name, _ in slots]
-    sizes = [len(v) for v in variables]
-    lower = np.concatenate([[v.lower for v in vs] for vs in variables])
-    upper = np.concatenate([[v.upper for v in vs] for vs in variables])
-    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
-    counter = {"n": 0}
-
-    def effects_of(z):
-        out, i = [], 0
-        for (name, side), size in zip(slots, sizes):
-            out.append(Effect(name, _to_physical(base, name, z[i:i + size], side)))
-            i += size
-        return out
-
-    def residual(z):
-        counter["n"] += 1
-        try:
-            trial = base.with_effects(effects_of(z))
-        except GfeInputError:
-            return np.full(n_res, 1e6)
-        r = _residuals(trial, measured, freq_noise, shape_noise, C)[0]
-        return np.full(n_res, 1e6) if r is None else r
-
-    def chi2(z):
-        return float(np.sum(residual(z) ** 2))
-
-    n_res = measured.n_modes * (1 + measured.n_sensors)
-    # -- starting point: present values, given starts, then a grid over the rest ---------
-    z0 = []
-    for (name, _side), vs in zip(slots, variables):
-        params = (start or {}).get(name) or (present[name].parameters if name in present
-                                             else None)
-        if params and all(v.name in params for v in vs):
-            z0.append(np.clip(_to_variables(base, name, params), [v.lower for v in vs],
-                              [v.upper for v in vs]))
-        else:
-            z0.append(None)
-    z_start = _grid_start(chi2, variables, z0)
-    # -- IPOPT (Gauss-Newton Hessian, finite-difference Jacobian) ------------------------
-    n = z_start.size
-    chi2_start = chi2(z_start)
-    scale = np.sqrt(max(chi2_start, 1.0))  # objective starts at 1/2: relative tolerances
-    r_fun = _Residual(lambda z: residual(z) / scale, n, n_res)
-    x = ca.MX.sym("z", n)
-    solver = ca.nlpsol("effects", "ipopt", {"x": x, "f": 0.5 * ca.sumsqr(r_fun(x))},
-                       {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
-                        "ipopt.max_iter": max_iter, "ipopt.tol": 1e-6,
-                        # finite-difference gradients carry ~1e-6 relative noise: stop when
-                        # the objective no longer moves rather than chase the gradient
-                        "ipopt.acceptable_tol": 1e-1, "ipopt.acceptable_iter": 2,
-                        "ipopt.acceptable_obj_change_tol": 1e-7})
-    sol = solver(x0=z_start, lbx=lower, ubx=upper)
-    stats = solver.stats()
-    z = np.array(sol["x"]).ravel()
-    if chi2(z) > chi2_start:  # never return worse than the start
-        z = z_start
-    effects = effects_of(z)
-    fitted = base.with_effects(effects)
-    status = str(stats.get("return_status"))
-    success = bool(stats.get("success")) or status in ("Solved_To_Acceptable_Level",
-                                                       "Maximum_Iterations_Exceeded")
-    name = adding[0].name if adding else "baseline"
-    params = next((e.parameters for e in effects if e.name == name), {})
-    return Fit(effect=name, parameters=params, model=fitted,
-               misfit=misfit(fitted, measured, freq_noise, shape_noise, C), status=status,
-               success=success, evaluations=counter["n"])
-
-
-def _grid_start(chi2, variables, z0):
-    """Best point of a coarse grid over the variables that have no starting value."""
-    fixed = [z for z in z0 if z is not None]
-    free = [i for i, z in enumerate(z0) if z is None]
-    if not free:
-        return np.concatenate(fixed) if fixed else np.zeros(0)
-    grids = [np.array(np.meshgrid(*[v.grid for v in variables[i]], indexing="ij")).reshape(
-        len(variables[i]), -1).T for i in free]
-    best, best_z = np.inf, None
-    # search each free slot's grid with the others at their first grid point
-    current = [z if z is not None else grids[free.index(i)][0] for i, z in enumerate(z0)]
-    for slot, grid in zip(free, grids):
-        for point in grid:
-            trial = list(current)
-            trial[slot] = point
-            value = chi2(np.concatenate(trial))
-            if value < best:
-                best, best_z = value, trial
-        current = best_z
-    return np.concatenate(current)
-
-
-# -------------------------------------------------------------------------------------------
-# Diagnose and update
-# -------------------------------------------------------------------------------------------
+    def to_json(self) -> dict:
+        return {"freq": self.freq, "shape": self.shape, "given": self.given,
+                "implied_freq": self.implied_freq, "implied_shape": self.implied_shape}
 
 
 @dataclass
 class Diagnosis:
-    """Ranked candidate effects (best first) and the baseline misfit."""
+    """Ranked candidate effects (best first), the verdict and what the data imply.
+
+    ``fits`` holds the candidates that were fitted (significant first, then by χ² plus
+    threshold); ``failed`` those whose fit failed or ended worse than the model without
+    them; ``skipped`` candidates that could not be fitted, with the reason.
+    """
 
     baseline: Misfit
+    reference: Fit | None
     fits: list
+    failed: list
+    skipped: list
+    verdict: str
+    noise: NoiseEstimate
     seconds: float
     localisation: list = field(default_factory=list)
-    realisation: list = field(default_factory=list)   # the nodal equations in words
+    realisation: list = field(default_factory=list)   # the generic update in words
     nodal: list = field(default_factory=list)         # Realisation per node
     generic_update: object = None                     # the UpdateResult they come from
-
-    def to_json(self) -> dict:
-        """The ``diagnose --json`` contract."""
-        return {"baseline": {"freq_error_rms_pct": self.baseline.freq_error_rms_pct,
-                             "mac_mean": self.baseline.mac_mean},
-                "effects": [{"effect": f.effect, "parameters": f.parameters,
-                             "freq_error_rms_pct": f.misfit.freq_error_rms_pct,
-                             "mac_mean": f.misfit.mac_mean, "significant": f.significant}
-                            for f in self.fits]}
+    profile_band: object = None                       # ProfileBand of the generic update
+    notes: list = field(default_factory=list)
 
     @property
     def best(self) -> Fit | None:
-        return next((f for f in self.fits if f.significant), None)
+        """The effect found (None unless the verdict is ``effect_found``)."""
+        return self.fits[0] if self.fits and self.fits[0].significant else None
+
+    @property
+    def current(self) -> Misfit:
+        """The misfit of the model as it stands (present effects re-estimated)."""
+        return self.reference.misfit if self.reference else self.baseline
+
+    def to_json(self) -> dict:
+        """The ``diagnose --json`` contract."""
+        return {"verdict": self.verdict,
+                "baseline": self.baseline.summary(),
+                "noise": self.noise.to_json(),
+                "effects": [f.to_json() for f in self.fits],
+                "failed": [{"effect": f.name, "status": f.status,
+                            **f.misfit.summary()} for f in self.failed],
+                "skipped": [{"effect": name, "reason": reason} for name, reason in self.skipped],
+                "realisation": list(self.realisation),
+                "notes": list(self.notes)}
+
+
+# -------------------------------------------------------------------------------------------
+# Checks
+# -------------------------------------------------------------------------------------------
+
+
+def fitted_parameter_count(name: str) -> int:
+    """Parameters of an effect that are fitted (a spring's side and a profile's knots are
+    chosen; a profile is counted by its smallest knot set)."""
+    kind = effect_type(name)
+    if getattr(kind, "fallback", False):
+        return KNOT_COUNTS[0]
+    return len([p for p in kind.parameters if p.name not in kind.fixed_keys()])
 
 
 def check_enough_modes(measured: MeasuredModes, effects) -> None:
-    """Each fitted effect needs at least as many measured modes as it has parameters (one
-    mode cannot tell a crack's position from its depth); several effects add up."""
-    need = sum(len(EFFECT_PARAMETERS[e.name]) - (1 if e.name == "support_spring" else 0)
-               for e in effects)
-    if measured.n_modes < need:
+    """Each effect needs at least as many measured modes as it has fitted parameters (one
+    mode cannot tell a crack's position from its depth); together they need five residuals
+    (frequencies and shape values) per parameter."""
+    for e in effects:
+        need = fitted_parameter_count(e.name)
+        if measured.n_modes < need:
+            raise GfeInputError(measured.source, "modes", f"{e.name} needs at least {need} "
+                                f"measured modes, the file has {measured.n_modes}")
+    total = sum(fitted_parameter_count(e.name) for e in effects)
+    residuals = measured.n_modes * (1 + measured.n_sensors)
+    if residuals < 5 * total:
         names = " + ".join(e.name for e in effects)
-        raise GfeInputError(measured.source, "modes", f"{names} needs at least {need} "
-                            f"measured modes, the file has {measured.n_modes}")
+        raise GfeInputError(measured.source, "modes", f"{names} has {total} parameters: the "
+                            f"{residuals} measured values (frequencies and shapes) cannot "
+                            "determine them (5 per parameter needed)")
 
 
-def _threshold(p: int) -> float:
-    return float(chdtri(p, 1.0 - SIGNIFICANCE_LEVEL))  # the χ²(p) quantile
-
-
-def diagnose(model: Model, measured: MeasuredModes, *, candidates=CANDIDATES,
-             freq_noise=DEFAULT_FREQ_NOISE, shape_noise=DEFAULT_SHAPE_NOISE,
-             progress=None, realise: bool = False) -> Diagnosis:
-    """Rank candidate effects by how much of the discrepancy each explains.
-
-    Each candidate is fitted together with the model's present effects (IPOPT); the
-    remaining error and significance are reported (module docstring).  ``progress`` is
-    called as ``progress(done, total, name)``.  With ``realise`` (beams), the generic-element
-    update (nodal k_i, ∂k_i/∂x) is run too and its nodal equations are read in words
-    (:func:`~gfe_opt.realisation.summarise`).
-    """
-    start = time.perf_counter()
+def _candidates(model: Model, candidates) -> list[str]:
+    if candidates is None:
+        return list(candidate_names(model.kind))
+    out = []
     for name in candidates:
-        _variables(model, name)  # rejects unknown names before any work
-    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
-    baseline = misfit(model, measured, freq_noise, shape_noise, C)
-    localisation = compare(model, measured, noise=max(shape_noise, 1e-3)).failure_places()
-    hint = localisation[0][0] / model.length if localisation else 0.5
-    # the model's present effects re-estimated alone: the reference for the candidates
-    reference = fit_effects(model, measured, [], freq_noise=freq_noise,
-                            shape_noise=shape_noise) if model.effects else None
-    ref_chi2 = reference.misfit.chi2 if reference else baseline.chi2
-    fits = []
-    jobs = []
-    present = {e.name for e in model.effects}
-    for name in candidates:
-        if name in present:  # already in the model: re-estimated in every fit
-            continue
-        try:
-            check_enough_modes(measured, [*model.effects, Effect(name, {})])
-        except GfeInputError:
-            continue  # too few modes to fit this candidate with the present effects
-        sides = ("left", "right", "both") if name == "support_spring" else (None,)
-        jobs += [(name, side) for side in sides]
-    fits = _run_jobs([(model, measured, name, {"side": side} if side else {}, hint,
-                       freq_noise, shape_noise) for name, side in jobs], progress)
-    # keep the best side of the support spring
-    springs = [f for f in fits if f.effect == "support_spring"]
-    if springs:
-        best_spring = min(springs, key=lambda f: f.misfit.chi2)
-        fits = [f for f in fits if f.effect != "support_spring"] + [best_spring]
-    material = next((f for f in fits if f.effect == "material"), None)
-    for f in fits:
-        p = len(_variables(model, f.effect))
-        better_than_reference = ref_chi2 - f.misfit.chi2 > _threshold(p)
-        if f.effect == "material" or material is None:
-            f.significant = better_than_reference and f.success
-        else:
-            extra = max(p - (0 if any(e.name == "material" for e in model.effects) else 0), 1)
-            f.significant = (better_than_reference and f.success
-                             and material.misfit.chi2 - f.misfit.chi2 > _threshold(extra))
-    fits.sort(key=lambda f: (not f.significant, f.misfit.chi2))
-    words, nodal, generic = (_generic_realisation(model, measured, shape_noise) if realise
-                             else ([], [], None))
-    return Diagnosis(baseline=baseline, fits=fits, seconds=time.perf_counter() - start,
-                     localisation=localisation, realisation=words, nodal=nodal,
-                     generic_update=generic)
+        kind = effect_type(name, "--candidates", None)
+        if model.kind not in kind.kinds:
+            raise GfeInputError("--candidates", name, f"does not apply to a {model.kind} "
+                                f"(it needs kind = {' or '.join(kind.kinds)})")
+        out.append(name)
+    return out
 
 
-def _generic_realisation(model: Model, measured: MeasuredModes, shape_noise: float):
-    """The generic-element update (beams) and what its nodal equations say:
-    ``(words, per-node realisations, UpdateResult)``."""
-    if model.kind != "beam":
-        return [], [], None
-    from .assembly import discretise
-    from .realisation import realise, summarise
-    from .updating import update_generic
-
-    disc = discretise(model)
-    result = update_generic(disc, measured, noise=max(shape_noise, 1e-3))
-    if not result.ok:
-        return [f"(the generic-element update did not converge: {result.status})"], [], result
-    nodal = realise(result.discretisation, disc)
-    words = summarise(nodal) or ["no change in the continuous equation beyond the noise"]
-    return words, nodal, result
+# -------------------------------------------------------------------------------------------
+# Fitting candidates (in parallel)
+# -------------------------------------------------------------------------------------------
 
 
-def _run_jobs(jobs, progress):
-    """Fit the candidates, in parallel over the machine's cores (fork, one BLAS thread per
-    worker; serial where processes cannot be forked or only one core is there); results in
-    the order given."""
+def _fit_candidate(model, measured, name, noise, hint, given=None, extra=()):
+    """Fit one candidate from each of its starting points, keep the best.  ``given`` holds
+    parameters the user fixed as starting values; ``extra`` effects are added first
+    (lookahead pairs)."""
+    kind = effect_type(name)
+    groups = {}  # starts that share their fixed parameters: one fit, the best start wins
+    for start in kind.starts(model, hint):
+        start = {**start, **(given or {})}
+        key = repr({k: start.get(k) for k in kind.fixed_keys()})
+        if start not in groups.setdefault(key, []):
+            groups[key].append(start)
+    best = None
+    for starts in groups.values():
+        fit = fit_effects(model, measured, [*extra, Effect(name, starts[0])], noise=noise,
+                          name=name, alternatives=starts[1:])
+        if best is None or fit.misfit.chi2 < best.misfit.chi2:
+            best = fit
+    if extra:
+        best.added = len(model.effects) + len(extra)
+    return best
+
+
+def _fit_profile(model, measured, name, noise, x, start_ratio):
+    """Fit a profile with knots ``x``, started from ``start_ratio`` (None: 1 everywhere)."""
+    ratio = list(start_ratio) if start_ratio is not None else [1.0] * len(x)
+    return fit_effects(model, measured, [Effect(name, {"x": list(x), "ratio": ratio})],
+                       noise=noise, name=name)
+
+
+def _job(args):
+    kind, payload = args
+    return {"profile": _fit_profile, "candidate": _fit_candidate,
+            "generic": _generic_update}[kind](*payload)
+
+
+def _run_jobs(jobs, progress, labels):
+    """Run fits, in parallel over the machine's cores (fork, one BLAS thread per worker;
+    serial where processes cannot be forked or only one core is there); results in order."""
     workers = min(len(jobs), os.cpu_count() or 1)
+    results = [None] * len(jobs)
     if progress:
         progress(0, len(jobs), "")
-    results = [None] * len(jobs)
     try:
         if workers < 2:
             raise OSError("one core")
         context = multiprocessing.get_context("fork")
         with ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                  initializer=_single_threaded_blas) as pool:
-            futures = {pool.submit(_fit_candidate, *job): i for i, job in enumerate(jobs)}
+            futures = {pool.submit(_job, job): i for i, job in enumerate(jobs)}
             for done, future in enumerate(as_completed(futures), start=1):
                 results[futures[future]] = future.result()
                 if progress:
-                    progress(done, len(jobs), jobs[futures[future]][2])
+                    progress(done, len(jobs), labels[futures[future]])
     except (OSError, ValueError, BrokenProcessPool):
         for i, job in enumerate(jobs):
             if results[i] is None:
-                results[i] = _fit_candidate(*job)
+                results[i] = _job(job)
             if progress:
-                progress(i + 1, len(jobs), job[2])
+                progress(i + 1, len(jobs), labels[i])
     return results
 
 
 def _single_threaded_blas():
-    """One BLAS thread per worker: the matrices are small and the workers share the cores
-    (measured: 2.9 s instead of 7.9 s with threaded BLAS in each worker)."""
+    """One BLAS thread per worker: the matrices are small and the workers share the cores."""
     from threadpoolctl import threadpool_limits
 
     global _BLAS_LIMIT
@@ -566,25 +310,312 @@ def _single_threaded_blas():
 _BLAS_LIMIT = None
 
 
-def _localisation_hint(model, measured, shape_noise) -> float:
-    """Where :func:`~gfe_opt.correlation.compare` says the model fails, as x / length."""
-    places = compare(model, measured, noise=max(shape_noise, 1e-3)).failure_places()
-    return places[0][0] / model.length if places else 0.5
+# -------------------------------------------------------------------------------------------
+# Model selection
+# -------------------------------------------------------------------------------------------
 
 
-def _fit_candidate(model, measured, name, params, hint, freq_noise, shape_noise):
-    """Fit one candidate; crack and point mass also try a start at the localisation."""
-    fit = fit_effects(model, measured, [Effect(name, params)], freq_noise=freq_noise,
-                      shape_noise=shape_noise)
-    if name in ("crack", "point_mass"):
-        guess = {"crack": {"position": hint * model.length, "depth_ratio": 0.45},
-                 "point_mass": {"position": hint * model.length,
-                                "mass": 0.2 * model.mass_per_length * model.length}}[name]
-        other = fit_effects(model, measured, [Effect(name, guess)], freq_noise=freq_noise,
-                            shape_noise=shape_noise)
-        if other.misfit.chi2 < fit.misfit.chi2:
-            fit = other
-    return fit
+@dataclass
+class _Selection:
+    """Thresholds shared by the tests of one diagnosis."""
+
+    reference_chi2: float
+    reference_params: int
+    n_candidates: int
+    n_modes: int
+    floor: float = 1.0
+
+    def alpha(self, name: str) -> float:
+        kind = effect_type(name)
+        if getattr(kind, "fallback", False):
+            places = len(KNOT_COUNTS)
+        elif any(p.rule == "position" for p in kind.parameters):
+            places = 2 * self.n_modes + 1
+        else:
+            places = 1
+        return (1.0 - SIGNIFICANCE_LEVEL) / (max(self.n_candidates, 1) * places)
+
+    def threshold(self, fit: Fit) -> float:
+        return self.floor * quantile(fit.n_params - self.reference_params,
+                                     self.alpha(fit.name))
+
+    def penalised(self, fit: Fit) -> float:
+        return fit.misfit.chi2 + self.threshold(fit)
+
+    def better(self, a: Fit, b: Fit, alpha: float | None = None) -> bool:
+        """a explains significantly more than b (nested or not)."""
+        p = max(a.n_params - b.n_params, 1)
+        alpha = self.alpha(a.name) if alpha is None else alpha
+        return b.misfit.chi2 - a.misfit.chi2 > self.floor * quantile(p, alpha)
+
+
+def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
+    base = model.with_effects([], check=False)
+    for f in fits:
+        kind = effect_type(f.name)
+        f.size_sigmas = kind.size_in_sigmas(base, f.parameters, f.uncertainty)
+        f.gain = sel.reference_chi2 - f.misfit.chi2
+        f.threshold = sel.threshold(f)
+        f.significant = (f.success and not f.failed and f.gain > f.threshold
+                         and f.size_sigmas >= SIZE_SIGMAS)
+        if f.significant and material is not None and f.name != "material" \
+                and not material.failed:
+            f.significant = sel.better(f, material)
+
+
+def _floor(fits) -> float:
+    values = [f.misfit.chi2 / max(f.misfit.n_residuals - f.n_params, 1)
+              for f in fits if f is not None and not f.failed and np.isfinite(f.misfit.chi2)]
+    return max(1.0, min(values)) if values else 1.0
+
+
+def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
+             freq_noise=None, shape_noise=None, progress=None,
+             realise: bool = False) -> Diagnosis:
+    """Which effect is missing (module docstring).  ``freq_noise`` and ``shape_noise`` are
+    relative (None: not given; defaults 0.05 % and 0.3 % are assumed and the data's own
+    level is estimated).  ``progress`` is called as ``progress(done, total, name)``.  With
+    ``realise`` (beams) the generic-element update is run and read in words."""
+    start = time.perf_counter()
+    noise = noise_of(freq_noise, shape_noise)
+    names = _candidates(model, candidates)
+    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    baseline = misfit(model, measured, noise, C)
+    places = compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
+    hint = places[0][0] / model.length if places else 0.5
+    reference = (fit_effects(model, measured, [], noise=noise, C=C)
+                 if slots_for(model, []) and any(s.variables for s in slots_for(model, []))
+                 else None)
+    ref_misfit = reference.misfit if reference else baseline
+    ref_params = reference.n_params if reference else 0
+
+    jobs, labels, skipped, fallback_names = [], [], [], []
+    for name in names:
+        kind = effect_type(name)
+        if not kind.local and any(e.name == name for e in model.effects):
+            continue  # present: re-estimated in every fit
+        if any(e.name in getattr(kind, "redundant_with", ()) for e in model.effects):
+            continue  # held by an effect present (E with a stiffness profile)
+        try:
+            check_enough_modes(measured, [*model.effects, Effect(name, {})])
+        except GfeInputError as exc:
+            skipped.append((name, exc.problem))
+            continue
+        if getattr(kind, "fallback", False):
+            fallback_names.append(name)
+            continue
+        jobs.append(("candidate", (model, measured, name, noise, hint)))
+        labels.append(name)
+    if candidates is not None and not jobs and not fallback_names:
+        raise GfeInputError(measured.source, "modes", "; ".join(f"{n}: {r}"
+                                                                for n, r in skipped))
+    with_generic = realise and model.kind == "beam"
+    if with_generic:  # the paper's generic update runs beside the candidates
+        jobs.append(("generic", (model, measured, noise)))
+        labels.append("generic-element update")
+    fits = _run_jobs(jobs, progress, labels) if jobs else []
+    generic, band = fits.pop() if with_generic else (None, None)
+    for f in fits:
+        # worse than the model without it (beyond rounding): a failed fit, not a candidate
+        f.failed = (not f.success) or f.misfit.chi2 > ref_misfit.chi2 * (1 + 1e-4) + 0.5
+    sel = _Selection(ref_misfit.chi2, ref_params, len(fits) + len(fallback_names),
+                     measured.n_modes)
+    sel.floor = _floor([*fits, reference])
+    material = next((f for f in fits if f.name == "material"), None)
+    _judge(fits, sel, material, model)
+
+    notes = []
+    words = nodal = None
+    best = _best(fits, sel)
+    need_profile = fallback_names and not fits_noise(
+        best.misfit if best else ref_misfit, best.n_params if best else ref_params)
+    if need_profile:
+        profile = _fallback(model, measured, noise, fallback_names, sel, band, progress)
+        if profile is not None:
+            sel.floor = _floor([*fits, reference, profile])
+            _judge([*fits, profile], sel, material, model)
+            best = _best(fits, sel)
+            if best is not None and sel.better(profile, best, 1.0 - SIGNIFICANCE_LEVEL):
+                pair = _lookahead(model, measured, noise, best, fits, hint, profile, sel)
+                if pair is not None:
+                    notes.append(f"{best.name} with a further {pair.name} explains the data as "
+                                 f"well as a free {profile.name}: add them one at a time")
+                    profile.significant = False  # named effects win where they explain
+                elif profile.significant:
+                    notes.append(f"{best.name} explains part of the difference; a "
+                                 f"{profile.name} explains significantly more")
+                    best.significant = False
+            fits.append(profile)
+    ranked = [f for f in fits if not f.failed]
+    ranked.sort(key=lambda f: (not f.significant, sel.penalised(f)))
+    failed = [f for f in fits if f.failed]
+    if realise and generic is not None:
+        from .realisation import describe_profile, explain
+        from .realisation import realise as realise_rows
+
+        if generic.ok:
+            nodal = realise_rows(generic.discretisation, _discretise(model))
+        found = ranked[0] if ranked and ranked[0].significant else None
+        if band is not None and found is not None:
+            band = explain(band, _discretise(model), _discretise(found.model), measured,
+                           noise)
+        words = (describe_profile(band, found.name if found else None) if band is not None
+                 else [])
+    estimate = _noise_estimate(model, measured, noise, [*ranked, reference], C, ref_misfit,
+                               sel.floor)
+    verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate)
+    notes += _noise_notes(estimate, verdict)
+    if skipped:
+        notes.append("not tried: " + "; ".join(f"{n} ({r})" for n, r in skipped))
+    return Diagnosis(baseline=baseline, reference=reference, fits=ranked, failed=failed,
+                     skipped=skipped, verdict=verdict, noise=estimate,
+                     seconds=time.perf_counter() - start, localisation=places,
+                     realisation=_words_for_verdict(words or [], verdict),
+                     nodal=nodal or [], generic_update=generic, profile_band=band,
+                     notes=notes)
+
+
+def _discretise(model):
+    from .assembly import discretise
+
+    return discretise(model)
+
+
+def _best(fits, sel):
+    significant = [f for f in fits if f.significant and not f.failed]
+    return min(significant, key=sel.penalised) if significant else None
+
+
+def _fallback(model, measured, noise, names, sel, band, progress):
+    """The profiles: each knot set fitted (in parallel), the coarsest that no finer one
+    beats significantly kept; the mass profile only if the stiffness one does not fit."""
+    chosen = None
+    for name in names:
+        counts = KNOT_COUNTS if name == "stiffness_profile" else KNOT_COUNTS[:3]
+        counts = [k for k in counts if k <= max(2, 2 * measured.n_modes - 1)]
+        jobs, labels = [], []
+        for k in counts:
+            x = np.linspace(0.0, model.length, k)
+            start = (_generic_ratio(band, model, x)
+                     if name == "stiffness_profile" and band is not None else None)
+            jobs.append(("profile", (model, measured, name, noise, x, start)))
+            labels.append(f"{name} ({k} knots)")
+        profiles = [f for f in _run_jobs(jobs, progress, labels) if f.success]
+        if not profiles:
+            continue
+        pick = profiles[0]
+        for finer in profiles[1:]:
+            if sel.better(finer, pick, 1.0 - SIGNIFICANCE_LEVEL):
+                pick = finer
+        if chosen is None or sel.better(pick, chosen, 1.0 - SIGNIFICANCE_LEVEL):
+            chosen = pick
+        if fits_noise(chosen.misfit, chosen.n_params):
+            break
+    return chosen
+
+
+def _generic_ratio(band, model, x):
+    """The generic update's nodal k_i / k_i0 (against its null profile) fitted by a
+    piecewise-linear function with knots x (least squares): the start of a stiffness
+    profile."""
+    ratio = band.ratio
+    hats = np.stack([np.interp(model.nodes, x, np.eye(len(x))[i]) for i in range(len(x))], 1)
+    values = np.linalg.lstsq(hats, ratio, rcond=None)[0]
+    return list(np.clip(values, 0.06, 2.9))
+
+
+def _lookahead(model, measured, noise, best, fits, hint, profile, sel):
+    """``best`` with one more effect: the next candidates by χ², and a further instance of
+    ``best`` when it is local.  Returns the first pair that explains the data as well as
+    ``profile`` (not significantly worse, or within the noise), else None."""
+    others = [f for f in sorted(fits, key=lambda f: f.misfit.chi2)
+              if f is not best and not f.failed and f.name != best.name][:3]
+    seconds = ([best.name] if effect_type(best.name).local else []) + [f.name for f in others]
+    first = Effect(best.name, best.parameters)
+    jobs = [("candidate", (model, measured, name, noise, hint, None, (first,)))
+            for name in seconds]
+    pairs = _run_jobs(jobs, None, seconds)
+    for pair in sorted(pairs, key=lambda f: f.misfit.chi2 + sel.floor * quantile(
+            f.n_params, sel.alpha(f.name))):
+        if fits_noise(pair.misfit, pair.n_params) or not sel.better(
+                profile, pair, 1.0 - SIGNIFICANCE_LEVEL):
+            return pair
+    return None
+
+
+def _generic_update(model, measured, noise):
+    """The paper's generic-element update (nodal k_i, ∂k_i/∂x) and its profile read against
+    its noise band (:func:`~gfe_opt.realisation.profile_band`)."""
+    from .assembly import discretise
+    from .realisation import profile_band
+    from .updating import update_generic
+
+    disc = discretise(model)
+    try:
+        result = update_generic(disc, measured, noise=max(noise.shape, 1e-3))
+    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+        return None, None
+    band = profile_band(disc, measured, result, noise) if result.ok else None
+    return result, band
+
+
+def _noise_estimate(model, measured, noise, fits, C, ref_misfit, floor) -> NoiseEstimate:
+    """The noise the data imply: the most flexible fit's frequency and shape residuals
+    against their degrees of freedom."""
+    usable = [f for f in fits if f is not None and not f.failed]
+    flexible = min(usable, key=lambda f: f.misfit.chi2 / max(f.misfit.n_residuals - f.n_params,
+                                                             1), default=None)
+    m = flexible.misfit if flexible else ref_misfit
+    p = flexible.n_params if flexible else 0
+    n_shape = m.n_residuals - m.n_freq
+    shape_dof = max(n_shape - p, 1)
+    implied_shape = noise.shape * np.sqrt((m.chi2 - m.chi2_freq) / shape_dof)
+    implied_freq = noise.freq * np.sqrt(m.chi2_freq / max(m.n_freq, 1))
+    correlation = shape_correlation(flexible.model if flexible else model, measured, noise, C)
+    return NoiseEstimate(noise.freq, noise.shape, noise.given, float(implied_freq),
+                         float(implied_shape), float(floor), correlation)
+
+
+def _verdict(ranked, ref_misfit, ref_params, noise, estimate) -> str:
+    if ranked and ranked[0].significant:
+        return "effect_found"
+    if fits_noise(ref_misfit, ref_params):
+        return "consistent"
+    if (not noise.given and abs(estimate.correlation) < WHITE_NOISE_CORRELATION
+            and estimate.implied_freq <= FREQ_NOISE_LIMIT * noise.freq):
+        return "consistent"
+    return "unexplained"
+
+
+def _noise_notes(est: NoiseEstimate, verdict: str) -> list[str]:
+    stated = "stated" if est.given else "assumed"
+    ratio_s = est.implied_shape / est.shape
+    ratio_f = est.implied_freq / est.freq
+    line = (f"the data imply shape noise {100 * est.implied_shape:.2g} % and frequency noise "
+            f"{100 * est.implied_freq:.2g} % ({stated}: {100 * est.shape:.2g} % and "
+            f"{100 * est.freq:.2g} %)")
+    notes = [line]
+    if max(ratio_s, ratio_f) > 1.5:
+        if abs(est.correlation) >= WHITE_NOISE_CORRELATION:
+            notes.append(f"the remaining shape residuals are correlated from sensor to sensor "
+                         f"({est.correlation:.2f}): a difference of the structure, not noise")
+        elif verdict == "consistent" and not est.given:
+            notes.append("the model agrees with the test at the noise the data imply; give "
+                         "--freq-noise/--shape-noise if the test's noise is known")
+    return notes
+
+
+def _words_for_verdict(words: list[str], verdict: str) -> list[str]:
+    """The generic update's words never contradict the verdict."""
+    if verdict == "consistent" and words and not words[0].startswith("no change"):
+        return ["the generic-element update shows " + "; ".join(words)
+                + " — none of it significant in the fits of physical effects"]
+    return words
+
+
+# -------------------------------------------------------------------------------------------
+# Update
+# -------------------------------------------------------------------------------------------
 
 
 @dataclass
@@ -595,73 +626,123 @@ class UpdateOutcome:
     after: Misfit
     model: Model
     fit: Fit
+    added: list = field(default_factory=list)
 
     def to_json(self) -> dict:
         """The ``update --json`` contract."""
-        def summary(m):
-            return {"freq_error_rms_pct": m.freq_error_rms_pct, "mac_mean": m.mac_mean}
-
-        return {"before": summary(self.before), "after": summary(self.after),
-                "effects": [{"effect": e.name, "parameters": e.parameters}
-                            for e in self.model.effects]}
+        return {"before": self.before.summary(), "after": self.after.summary(),
+                "effects": [{"effect": e.name, "parameters": jsonable(e.parameters),
+                             "uncertainty": jsonable(s)}
+                            for e, s in zip(self.fit.effects, self.fit.sigma)]}
 
 
 def parse_effect(text: str, model: Model, where: str = "--add") -> Effect:
-    """``crack`` or ``crack:position=0.2,depth_ratio=0.4`` -> Effect (parameters validated
-    when all are given; partial ones are starting values)."""
+    """``crack`` or ``crack:position=0.2,depth_ratio=0.4`` -> Effect.  Every value given is
+    checked against its allowed range (partial sets are starting values); a repeated or
+    unknown key is an error.  Lists (profiles) separate values by ``;``."""
     name, _, rest = text.partition(":")
-    if name not in EFFECT_PARAMETERS:
-        raise GfeInputError(where, text, f"unknown effect {name!r} "
-                            f"(known: {', '.join(EFFECT_PARAMETERS)})")
+    kind = effect_type(name.strip(), where, None)
     params = {}
-    for item in filter(None, rest.split(",")):
-        key, eq, value = item.partition("=")
-        if not eq or key not in EFFECT_PARAMETERS[name]:
-            raise GfeInputError(where, text, f"expected key=value with keys "
-                                f"{', '.join(EFFECT_PARAMETERS[name])}, got {item!r}")
-        if key == "side":
+    for item in rest.split(",") if rest.strip() else []:
+        key, eq, value = (part.strip() for part in item.partition("="))
+        if not eq or not value:
+            raise GfeInputError(where, text, f"expected key=value, got {item!r}")
+        if key not in kind.keys:
+            from .effects.base import no_unknown
+
+            try:
+                no_unknown({key: None}, set(kind.keys), where, "")
+            except GfeInputError as exc:
+                raise GfeInputError(where, text, f"{key}: {exc.problem} ({name} takes "
+                                    f"{', '.join(kind.keys)})") from None
+        if key in params:
+            raise GfeInputError(where, text, f"{key} is given twice")
+        rule = kind.parameter(key).rule
+        if rule == "choice":
             params[key] = value
         else:
             try:
-                params[key] = float(value)
+                numbers = [float(v) for v in value.split(";")]
             except ValueError:
                 raise GfeInputError(where, text, f"{key} must be a number, got {value!r}"
                                     ) from None
-    if set(params) == set(EFFECT_PARAMETERS[name]):
-        params = validate_effect(model, name, params, where, "")
-    return Effect(name, params)
+            params[key] = numbers if rule in ("knots", "ratios") else (
+                numbers[0] if len(numbers) == 1 else value)
+    params = validate_effect(model, kind.name, params, f"{where} {text}", "", partial=True)
+    return Effect(kind.name, params)
 
 
-def update(model: Model, measured: MeasuredModes, add, *, freq_noise=DEFAULT_FREQ_NOISE,
-           shape_noise=DEFAULT_SHAPE_NOISE) -> UpdateOutcome:
-    """Add effects (names, ``name:key=value`` strings or :class:`Effect`) and fit all of the
-    model's effects' physical parameters with IPOPT.  Starting values: those given, else
-    the diagnosis of each effect alone."""
+def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
+           shape_noise=None) -> UpdateOutcome:
+    """Add effect instances (names, ``name:key=value`` strings or :class:`Effect`) and fit
+    all of the model's effects' parameters with IPOPT.  The present instances are
+    re-estimated from where they are; an added one starts from the values given, the rest
+    from the diagnosis of that effect alone.  A global effect already in the model, or
+    added twice, is an error."""
+    noise = noise_of(freq_noise, shape_noise)
     effects = [parse_effect(a, model) if isinstance(a, str) else a for a in add]
-    check_enough_modes(measured, [*model.effects,
-                                  *[e for e in effects if e.name not in
-                                    {m.name for m in model.effects}]])
+    for e in effects:
+        effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
+                                     partial=True)
+    check_repeats([*model.effects, *effects], "--add", "effects")
+    check_enough_modes(measured, [*model.effects, *effects])
     C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
-    before = misfit(model, measured, freq_noise, shape_noise, C)
-    incomplete = [e for e in effects if set(e.parameters) != set(EFFECT_PARAMETERS[e.name])]
-    hint = _localisation_hint(model, measured, shape_noise) if incomplete else 0.5
+    before = misfit(model, measured, noise, C)
+    hint = None
     starts = []
     for e in effects:
-        if e.name == "support_spring" and "side" not in e.parameters:
-            single = min((_fit_candidate(model, measured, e.name, {"side": s}, hint,
-                                         freq_noise, shape_noise)
-                          for s in ("left", "right", "both")), key=lambda f: f.misfit.chi2)
-            starts.append(Effect(e.name, single.parameters))
-        elif set(e.parameters) != set(EFFECT_PARAMETERS[e.name]):
-            single = _fit_candidate(model, measured, e.name,
-                                    {k: v for k, v in e.parameters.items() if k == "side"},
-                                    e.parameters.get("position", hint * model.length)
-                                    / model.length, freq_noise, shape_noise)
-            starts.append(Effect(e.name, {**single.parameters, **e.parameters}))
-        else:
+        kind = effect_type(e.name)
+        fitted = [v.key for v in kind.variables(model, {**_default_fixed(kind, model),
+                                                       **e.parameters})]
+        if all(k in e.parameters for k in fitted) and all(k in e.parameters
+                                                          for k in kind.fixed_keys()):
             starts.append(e)
-    fit = fit_effects(model, measured, starts, freq_noise=freq_noise, shape_noise=shape_noise,
-                      start={e.name: e.parameters for e in starts})
+            continue
+        if getattr(kind, "fallback", False):
+            starts.append(_profile_start(model, measured, e, noise))
+            continue
+        if hint is None:
+            places = compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
+            hint = places[0][0] / model.length if places else 0.5
+        where = e.parameters.get("position")
+        single = _fit_candidate(model, measured, e.name, noise,
+                                where / model.length if where is not None else hint,
+                                given=e.parameters)
+        starts.append(Effect(e.name, {**single.parameters, **e.parameters}))
+    fit = fit_effects(model, measured, starts, noise=noise, C=C,
+                      name=" + ".join(e.name for e in effects))
     if not fit.success:
         raise GfeSolverError(f"IPOPT did not fit the effects ({fit.status})")
-    return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit)
+    return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit,
+                         added=list(range(len(model.effects), len(fit.effects))))
+
+
+def _default_fixed(kind, model):
+    """Placeholder fixed parameters so that a kind can list its variables."""
+    out = {}
+    for key in kind.fixed_keys():
+        p = kind.parameter(key)
+        out[key] = p.choices[0] if p.rule == "choice" else [0.0, model.length]
+    return out
+
+
+def _profile_start(model, measured, effect, noise):
+    """A profile to add: the given knots, else the knot set chosen as in the diagnosis;
+    ratios from the generic update (stiffness) or 1."""
+    if "x" in effect.parameters and "ratio" in effect.parameters:
+        return effect
+    band = None
+    if effect.name == "stiffness_profile" and model.kind == "beam":
+        _, band = _generic_update(model, measured, noise)
+    if "x" in effect.parameters:
+        x = effect.parameters["x"]
+        start = (_generic_ratio(band, model, np.asarray(x)) if band is not None
+                 else [1.0] * len(x))
+        return Effect(effect.name, {"x": list(x), "ratio": list(start)})
+    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    ref = misfit(model, measured, noise, C)
+    sel = _Selection(ref.chi2, 0, 1, measured.n_modes)
+    chosen = _fallback(model, measured, noise, [effect.name], sel, band, None)
+    if chosen is None:
+        raise GfeSolverError(f"the {effect.name} could not be fitted")
+    return Effect(effect.name, chosen.parameters)

@@ -460,12 +460,17 @@ def beam_stiffness_from_flexibility(rigidity, x0, L, breakpoints=(), refine_scal
     for nodal loads, whatever the element size.  Returns ``(k_ww, k_wt, k_tt)`` of eq. 11.
     """
     x, w = element_quadrature(x0, x0 + L, breakpoints, refine_scale)
-    s = x - x0
-    c = w / rigidity(x)
-    f2, f1, f0 = np.stack([s * s, s, np.ones_like(s)]) @ c
-    f = np.array([[f2, -f1], [-f1, f0]])
-    kii = np.linalg.inv(f)
-    # scaled DOFs [w, L theta]: H_scaled = [[1, 0, -1, 1], [0, 1/L, 0, -1/L]]
-    h = np.array([[1.0, 0.0, -1.0, 1.0], [0.0, 1.0 / L, 0.0, -1.0 / L]])
-    k = h.T @ kii @ h * L**3
-    return k[0, 0], k[0, 1], k[1, 1]
+    return flexibility_parameters(x - x0, w / rigidity(x), L)
+
+
+def flexibility_parameters(s, c, L):
+    r"""``(k_ww, k_wt, k_tt)`` of the exact static element from quadrature: ``s`` local
+    coordinates and ``c`` = weights / EI at the points (last axis; leading axes are
+    elements).  With :math:`f_n = \sum c\, s^n`, :math:`F = [[f_2, -f_1], [-f_1, f_0]]` and
+    in scaled DOFs :math:`k_{ww} = L^3 f_0/Δ`, :math:`k_{wθ} = L^2 f_1/Δ`,
+    :math:`k_{θθ} = L f_2/Δ`, :math:`Δ = f_2 f_0 - f_1^2`."""
+    f0 = np.sum(c, axis=-1)
+    f1 = np.sum(c * s, axis=-1)
+    f2 = np.sum(c * s * s, axis=-1)
+    det = f2 * f0 - f1 * f1
+    return L**3 * f0 / det, L**2 * f1 / det, L * f2 / det

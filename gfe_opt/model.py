@@ -25,8 +25,6 @@ The file form is a contract (see README, "Model file")::
 
 from __future__ import annotations
 
-import difflib
-import math
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -34,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from .effects.base import as_float, no_unknown
 from .errors import GfeInputError
 
 BEAM_SUPPORTS = ("pinned", "clamped", "free", "sliding")
@@ -41,25 +40,10 @@ BAR_SUPPORTS = ("fixed", "free")
 BEAM_MASS_MODELS = ("consistent", "higher_order")
 BAR_MASS_MODELS = ("consistent", "lumped", "harmonic", "minimum_error")
 
-#: Effect names and their parameter keys (a contract shared with model files and the CLI).
-#: Each entry: parameter -> (unit, kind) with kind "positive", "real", "fraction" or "side".
-EFFECT_PARAMETERS: dict[str, dict[str, tuple[str, str]]] = {
-    "material": {"E": ("Pa", "positive")},
-    "crack": {"position": ("m", "position"), "depth_ratio": ("-", "fraction")},
-    "shear": {"shear_rigidity": ("N", "positive")},
-    "axial_load": {"tension": ("N", "real")},
-    "foundation": {"stiffness": ("N/m^2", "positive")},
-    "support_spring": {"stiffness": ("N m/rad", "positive"), "side": ("", "side")},
-    "point_mass": {"position": ("m", "position"), "mass": ("kg", "positive")},
-}
-#: Effects that only make sense for a beam (transverse bending).
-BEAM_ONLY_EFFECTS = ("crack", "shear", "axial_load", "foundation", "support_spring")
-SPRING_SIDES = ("left", "right", "both")
-
-
 @dataclass(frozen=True)
 class Effect:
-    """A physical effect present in a model: its name and physical parameters (SI)."""
+    """One instance of a physical effect in a model: its name (a registered
+    :class:`~gfe_opt.effects.EffectType`) and physical parameters (SI)."""
 
     name: str
     parameters: dict[str, Any]
@@ -70,6 +54,8 @@ class Effect:
 
 
 def _fmt(v):
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_fmt(x) for x in v) + "]"
     return f"{v:.6g}" if isinstance(v, float) else str(v)
 
 
@@ -100,11 +86,13 @@ class Model:
     # -- derived quantities -----------------------------------------------------------
     @property
     def youngs_modulus(self) -> float:
-        """E, overridden by a ``material`` effect when present."""
+        """E with the effects (a ``material`` effect sets it)."""
+        from .effects import effect_type
+
+        E = self.E
         for e in self.effects:
-            if e.name == "material":
-                return float(e.parameters["E"])
-        return self.E
+            E = effect_type(e.name).youngs_modulus(e.parameters, E)
+        return E
 
     @property
     def bending_rigidity(self) -> float:
@@ -140,11 +128,16 @@ class Model:
     def effects_named(self, name: str) -> list[Effect]:
         return [e for e in self.effects if e.name == name]
 
-    def with_effects(self, effects) -> "Model":
-        """A copy with ``effects`` (an iterable of :class:`Effect`) replacing the present ones."""
+    def with_effects(self, effects, check: bool = True) -> "Model":
+        """A copy with ``effects`` (an iterable of :class:`Effect`) replacing the present ones,
+        validated unless ``check`` is False (fitting loops, whose values lie in bounds)."""
         effects = tuple(effects)
-        for e in effects:
-            validate_effect(self, e.name, dict(e.parameters), self.source or "model")
+        if check:
+            effects = tuple(Effect(e.name, validate_effect(self, e.name, dict(e.parameters),
+                                                           self.source or "model",
+                                                           f"effects[{i}]."))
+                            for i, e in enumerate(effects))
+            check_repeats(effects, self.source or "model")
         return replace(self, effects=effects)
 
     def with_elements(self, elements: int) -> "Model":
@@ -173,7 +166,7 @@ def load_model(path) -> Model:
 
 def model_from_dict(data: dict, where: str = "model") -> Model:
     """Build a :class:`Model` from the parsed TOML mapping (same validation as files)."""
-    _no_unknown(data, {"name", "kind", "length", "elements", "material", "section",
+    no_unknown(data, {"name", "kind", "length", "elements", "material", "section",
                        "supports", "effects", "mass"}, where, "")
     kind = _choice(data, "kind", ("beam", "bar"), where)
     length = _number(data, "length", where, positive=True)
@@ -187,7 +180,7 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         raise GfeInputError(where, "name", f"must be a string, got {name!r}")
 
     material = _table(data, "material", where)
-    _no_unknown(material, {"E", "rho", "nu"}, where, "material.")
+    no_unknown(material, {"E", "rho", "nu"}, where, "material.")
     E = _number(material, "E", where, positive=True, prefix="material.")
     rho = _number(material, "rho", where, positive=True, prefix="material.")
     nu = _number(material, "nu", where, prefix="material.", default=0.3)
@@ -202,12 +195,12 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         if shape != "rectangle":
             raise GfeInputError(where, "section.shape",
                                 f"unknown shape {shape!r} (known: 'rectangle', or give A and I)")
-        _no_unknown(section, {"shape", "b", "h"}, where, "section.")
+        no_unknown(section, {"shape", "b", "h"}, where, "section.")
         breadth = _number(section, "b", where, positive=True, prefix="section.")
         depth = _number(section, "h", where, positive=True, prefix="section.")
         area, inertia = breadth * depth, breadth * depth**3 / 12.0
     else:
-        _no_unknown(section, {"A", "I", "h"}, where, "section.")
+        no_unknown(section, {"A", "I", "h"}, where, "section.")
         area = _number(section, "A", where, positive=True, prefix="section.")
         need_i = kind == "beam"
         inertia = _number(section, "I", where, positive=True, prefix="section.",
@@ -216,7 +209,7 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
             depth = _number(section, "h", where, positive=True, prefix="section.")
 
     supports_tbl = _table(data, "supports", where)
-    _no_unknown(supports_tbl, {"left", "right"}, where, "supports.")
+    no_unknown(supports_tbl, {"left", "right"}, where, "supports.")
     allowed = BEAM_SUPPORTS if kind == "beam" else BAR_SUPPORTS
     supports = tuple(_choice(supports_tbl, side, allowed, where, prefix="supports.")
                      for side in ("left", "right"))
@@ -253,51 +246,32 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         if name_ is None:
             raise GfeInputError(where, f"effects[{i}].effect", "missing (the effect's name)")
         effects.append(Effect(name_, validate_effect(model, name_, raw, where, f"effects[{i}].")))
+    check_repeats(effects, where)
     return replace(model, effects=tuple(effects))
 
 
-def validate_effect(model: Model, name: str, params: dict, where: str, prefix: str = "") -> dict:
-    """Check an effect's name and parameters against :data:`EFFECT_PARAMETERS`; return them."""
-    if name not in EFFECT_PARAMETERS:
-        raise GfeInputError(where, f"{prefix}effect",
-                            f"unknown effect {name!r} (known: {', '.join(EFFECT_PARAMETERS)})")
-    if model.kind != "beam" and name in BEAM_ONLY_EFFECTS:
-        raise GfeInputError(where, f"{prefix}effect", f"effect {name!r} needs kind = \"beam\"")
-    spec = EFFECT_PARAMETERS[name]
-    _no_unknown(params, set(spec), where, prefix)
-    out = {}
-    for key, (unit, rule) in spec.items():
-        if key not in params:
-            raise GfeInputError(where, f"{prefix}{key}", f"missing ({name} needs {key} [{unit}])")
-        value = params[key]
-        if rule == "side":
-            if value not in SPRING_SIDES:
-                raise GfeInputError(where, f"{prefix}{key}",
-                                    f"must be one of {', '.join(SPRING_SIDES)}, got {value!r}")
-            out[key] = value
-            continue
-        value = _as_float(value, where, f"{prefix}{key}")
-        if rule == "positive" and value <= 0:
-            raise GfeInputError(where, f"{prefix}{key}", f"must be > 0 [{unit}], got {value:g}")
-        if rule == "fraction" and not 0.0 < value < 1.0:
-            raise GfeInputError(where, f"{prefix}{key}", f"must lie in (0, 1), got {value:g}")
-        if rule == "position" and not 0.0 <= value <= model.length:
-            raise GfeInputError(where, f"{prefix}{key}",
-                                f"{value:g} m lies outside the structure [0, {model.length:g}] m")
-        out[key] = value
-    if name == "crack" and model.depth is None:
-        raise GfeInputError(where, f"{prefix}effect",
-                            "a crack needs the section depth (section.h or shape = 'rectangle')")
-    return out
+def validate_effect(model: Model, name: str, params: dict, where: str, prefix: str = "",
+                    partial: bool = False) -> dict:
+    """Check an effect's name and parameters (its :class:`~gfe_opt.effects.EffectType`
+    says how); return them.  ``partial``: only the parameters given are required."""
+    from .effects import effect_type
+
+    return effect_type(name, where, f"{prefix}effect").validate(model, params, where, prefix,
+                                                                 partial)
 
 
-def _as_float(value, where, fieldname):
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise GfeInputError(where, fieldname, f"must be a number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise GfeInputError(where, fieldname, f"must be finite, got {value}")
-    return value
+def check_repeats(effects, where: str, prefix: str = "effects") -> None:
+    """A global effect (``material``, ``shear``, ...) may appear once; local ones repeat."""
+    from .effects import effect_type
+
+    seen = {}
+    for i, e in enumerate(effects):
+        if e.name in seen and not effect_type(e.name).local:
+            raise GfeInputError(where, f"{prefix}[{i}].effect", f"{e.name!r} appears twice "
+                                f"(also {prefix}[{seen[e.name]}]): a global effect is one per "
+                                "model; local effects (crack, point_mass, point_spring, "
+                                "section_loss, ...) may repeat")
+        seen.setdefault(e.name, i)
 
 
 def _number(tbl, key, where, positive=False, prefix="", default=None):
@@ -305,7 +279,7 @@ def _number(tbl, key, where, positive=False, prefix="", default=None):
         if default is not None:
             return default
         raise GfeInputError(where, prefix + key, "missing")
-    value = _as_float(tbl[key], where, prefix + key)
+    value = as_float(tbl[key], where, prefix + key)
     if positive and value <= 0:
         raise GfeInputError(where, prefix + key, f"must be > 0, got {value:g}")
     return value
@@ -328,14 +302,6 @@ def _table(data, key, where):
     if not isinstance(tbl, dict):
         raise GfeInputError(where, key, "must be a table")
     return tbl
-
-
-def _no_unknown(tbl, known, where, prefix):
-    for key in tbl:
-        if key not in known:
-            close = difflib.get_close_matches(key, sorted(known), n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise GfeInputError(where, prefix + key, f"unknown key{hint}")
 
 
 def model_to_dict(model: Model) -> dict:

@@ -41,6 +41,20 @@ def derive_nodal_coefficients() -> sympy.Matrix:
     return sympy.Matrix(rows)
 
 
+@lru_cache(maxsize=1)
+def nodal_coefficients() -> np.ndarray:
+    """Eq. 13 as floats (3, 4): the same integral as :func:`derive_nodal_coefficients`,
+    evaluated by Gauss quadrature (exact: the integrand has degree 5), without sympy at
+    run time."""
+    from .elements import _gauss_legendre, hermite, hermite_d2
+
+    g, w = _gauss_legendre(4)
+    xi, w = 0.5 * (g + 1.0), 0.5 * w
+    h, b = hermite(xi), hermite_d2(xi)
+    return np.array([[np.sum(w * h[:, k] * b[:, i] * b[:, j]) for k in range(4)]
+                     for i, j in ((0, 0), (0, 1), (1, 1))])
+
+
 BEAM_KEYS = ("k_ww", "k_wt", "k_tt")
 BAR_KEYS = ("k",)
 
@@ -87,7 +101,7 @@ def beam_parameterisation(name: str, n_elements: int, element_length: float) -> 
                                 tuple(f"{k}[{i}]" for k in ("k_ww", "k_wt", "k_tt")
                                       for i in range(n)))
     if name == "nodal":
-        c = np.array(derive_nodal_coefficients(), dtype=float)  # (3, 4)
+        c = nodal_coefficients()  # (3, 4)
         # q = [k_0..k_N, k'_0..k'_N]; element columns k_i, k'_i L, k_{i+1}, k'_{i+1} L
         cols = np.stack([e, n + 1 + e, e + 1, n + 1 + e + 1], axis=1)
         scale = np.array([1.0, L, 1.0, L])

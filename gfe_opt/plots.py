@@ -47,6 +47,27 @@ def parameter_changes(curves, *, quantity: str, title: str, crack_position=None)
     return fig
 
 
+def profile_with_band(band, label=None):
+    """The generic update's k_i / k_i0 along the structure with its ±3σ noise band and, when
+    an effect was found, what the update reads from that effect's own modes."""
+    fig = _figure()
+    ax = fig.add_subplot()
+    x = band.x
+    ok = np.isfinite(band.sigma)
+    ax.fill_between(x[ok], (1 - 3 * band.sigma)[ok], (1 + 3 * band.sigma)[ok], color="0.85",
+                    label="noise band (±3σ)")
+    ax.plot(x, band.ratio, "o-", ms=3, color="tab:blue", label="generic update of the data")
+    if band.explained is not None:
+        ax.plot(x, band.explained, "--", color="tab:red",
+                label=f"... of the fitted {label}'s modes")
+    ax.axhline(1.0, color="0.4", lw=0.8)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("$k_i / k_{i,0}$")
+    ax.set_title("Generic-element update: nodal bending stiffness over the model's")
+    ax.legend(fontsize=8)
+    return fig
+
+
 def disturbance_function(x_nodes, q_identified, x_fine, q_exact, *, label_exact: str):
     """The paper's Fig. 5: identified Q_i at the nodes (circles) and Q(x) (solid)."""
     fig = _figure()

@@ -26,28 +26,22 @@ def compare_figures(result, model) -> dict:
 
 
 def diagnosis_figures(diagnosis, model) -> dict:
-    """Candidate errors; with the generic update: stiffness changes, nodal equation
-    coefficients and (for a crack) the identified Q_i against Christides–Barr Q(x)."""
+    """Candidate errors; with the generic update: its stiffness profile against the noise
+    band and what the effect found would show, the nodal equation coefficients and (for a
+    crack) the identified Q_i against Christides–Barr Q(x)."""
     figs = {"candidates.png": plots.candidate_errors(diagnosis.fits,
-                                                     diagnosis.baseline.freq_error_rms_pct)}
-    generic = diagnosis.generic_update
-    if generic is not None and generic.parameterisation.name == "nodal":
-        n = model.elements
-        k0 = model.bending_rigidity
-        x = model.nodes
-        figs["stiffness_change.png"] = plots.parameter_changes(
-            [("k_i", x, 100 * (generic.q[:n + 1] / k0 - 1))], quantity="Δk_i / k_0 [%]",
-            title="Generic-element update: change of the nodal bending stiffness")
-        figs["slope_change.png"] = plots.parameter_changes(
-            [("∂k_i/∂x", x, 100 * generic.q[n + 1:] * model.length / k0)],
-            quantity="Δ(∂k_i/∂x) ℓ / k_0 [%]", title="... and of its slope")
-        best = diagnosis.best
-        if best is not None and best.effect == "crack" and model.depth:
+                                                     diagnosis.current.freq_error_rms_pct)}
+    band = diagnosis.profile_band
+    best = diagnosis.best
+    if band is not None:
+        figs["stiffness_change.png"] = plots.profile_with_band(
+            band, label=best.name if best else None)
+        if best is not None and best.name == "crack" and model.depth:
             fine = np.linspace(0, model.length, 2000)
             q = christides_barr_q(fine, best.parameters["position"],
                                   best.parameters["depth_ratio"], model.depth / 2)
             figs["disturbance.png"] = plots.disturbance_function(
-                x, generic.q[:n + 1] / k0, fine, q,
+                band.x, band.ratio, fine, q,
                 label_exact=f"Q(x), fitted a/d = {best.parameters['depth_ratio']:.2f}")
     if diagnosis.nodal:
         figs["nodal_equations.png"] = plots.nodal_coefficients(diagnosis.nodal)

@@ -13,22 +13,26 @@ from __future__ import annotations
 import numpy as np
 
 from . import elements as el
-from .assembly import crack_element_parameters, discretise
+from .assembly import discretise, rigidity_function
 from .measured import MeasuredModes, make_measured, sensor_matrix
 from .modal import discretisation_modes
 from .model import Effect, Model
 
 
 def reference_discretisation(truth: Model, elements: int):
-    """Fine-mesh discretisation of ``truth``, cracks integrated with Hermite curvatures."""
+    """Fine-mesh discretisation of ``truth``; a beam's varying EI(x) (cracks, zones,
+    profiles) integrated with Hermite curvatures instead of exact-flexibility elements."""
     fine = truth.with_elements(elements)
-    if not fine.effects_named("crack"):
-        return discretise(fine)
-    disc = discretise(fine.with_effects(e for e in fine.effects if e.name != "crack"))
+    disc = discretise(fine)
+    rigidity, breakpoints = rigidity_function(fine)
+    if fine.kind != "beam" or not breakpoints and not fine.effects_named("stiffness_profile"):
+        return disc
     if fine.effects_named("shear"):
-        raise NotImplementedError("reference with both crack and shear is not provided")
-    params = crack_element_parameters(fine, el.beam_stiffness_from_rigidity)
-    return disc.with_stiffness(params)
+        raise NotImplementedError("reference with both a varying EI and shear is not provided")
+    L = fine.element_length
+    k = np.array([el.beam_stiffness_from_rigidity(rigidity, e * L, L, breakpoints, L / 64)
+                  for e in range(elements)])
+    return disc.with_stiffness({"k_ww": k[:, 0], "k_wt": k[:, 1], "k_tt": k[:, 2]})
 
 
 def reference_with_rigidity(model: Model, rigidity, elements: int):

@@ -121,7 +121,7 @@ def test_malformed_measured_files(good, tmp_path, capsys, name, text, match):
     (["compare", "{model}", "{m}", "--mac-threshold", "2"], "--mac-threshold: must lie in"),
     (["diagnose", "{model}", "{m}", "--candidates", "rust"], "unknown effect"),
     (["update", "{model}", "{m}", "--add", "crack:depth_ratio=1.5,position=0.2"],
-     "depth_ratio: must lie in (0, 1)"),
+     "depth_ratio: must lie between 0 and 1"),
     (["modes", "{model}", "--out", "{tmp}/x.uff", "--modes", "0"], "--modes: must be >= 1"),
     (["update", "{model}", "{m1}", "--add", "crack"], "crack needs at least 2 measured modes"),
 ])

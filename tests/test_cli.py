@@ -69,8 +69,8 @@ def test_demo_tells_the_whole_story_and_refuses_to_overwrite(tmp_path, capsys):
     text = capsys.readouterr().out
     assert (out / "model.toml").exists() and (out / "measured.json").exists()
     assert "the model fails most near x = 0.1" in text
-    assert "most likely missing: crack" in text
-    assert "nothing significant is left" in text
+    assert "verdict: an effect is missing\n     crack: position = 0.19" in text
+    assert "nothing significant is left: consistent" in text
     updated = load_model(out / "updated.toml")
     assert [e.name for e in updated.effects] == ["crack"]
     assert abs(updated.effects[0].parameters["position"] - 0.19) < 0.015
@@ -83,13 +83,20 @@ def test_diagnose_json_contract(files, capsys):
     assert main(["diagnose", str(model), str(measured), "--json",
                  "--candidates", "material,crack"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert set(data) == {"baseline", "effects"}
-    assert set(data["baseline"]) == {"freq_error_rms_pct", "mac_mean"}
+    assert set(data) == {"verdict", "baseline", "noise", "effects", "failed", "skipped",
+                         "realisation", "notes"}
+    assert data["verdict"] == "effect_found"
+    assert set(data["baseline"]) == {"freq_error_rms_pct", "mac_mean", "chi2_per_residual"}
+    assert set(data["noise"]) == {"freq", "shape", "given", "implied_freq", "implied_shape"}
     assert [e["effect"] for e in data["effects"]][0] == "crack"
     for entry in data["effects"]:
-        assert set(entry) == {"effect", "parameters", "freq_error_rms_pct", "mac_mean",
-                              "significant"}
-    assert abs(data["effects"][0]["parameters"]["position"] - 0.4) < 0.015
+        assert set(entry) == {"effect", "parameters", "uncertainty", "freq_error_rms_pct",
+                              "mac_mean", "chi2_per_residual", "significant"}
+        assert set(entry["uncertainty"]) <= set(entry["parameters"])
+    first = data["effects"][0]
+    assert first["significant"] and abs(first["parameters"]["position"] - 0.4) < 0.015
+    # the truth lies within a few standard deviations, which are small but not zero
+    assert 0 < first["uncertainty"]["position"] < 0.005
 
 
 def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_path):
@@ -99,7 +106,10 @@ def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_p
                  "--out", str(out), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert set(data) == {"before", "after", "effects"}
-    assert set(data["before"]) == set(data["after"]) == {"freq_error_rms_pct", "mac_mean"}
+    assert set(data["before"]) == set(data["after"]) == {"freq_error_rms_pct", "mac_mean",
+                                                         "chi2_per_residual"}
+    assert data["after"]["chi2_per_residual"] < 2.0 < data["before"]["chi2_per_residual"]
+    assert set(data["effects"][0]) == {"effect", "parameters", "uncertainty"}
     assert data["after"]["freq_error_rms_pct"] < 0.1 * data["before"]["freq_error_rms_pct"]
     assert data["effects"][0]["effect"] == "crack"
     assert [e.name for e in load_model(out).effects] == ["crack"]
@@ -113,7 +123,7 @@ def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_p
 
 
 @pytest.mark.parametrize("add,match", [("rust", "unknown effect 'rust'"),
-                                       ("crack:depth=0.2", "expected key=value"),
+                                       ("crack:depth=0.2", "did you mean 'depth_ratio'"),
                                        ("crack:position=abc", "must be a number")])
 def test_bad_add_exits_2(files, capsys, add, match):
     model, measured, _ = files

@@ -77,7 +77,7 @@ def test_bad_model_files(tmp_path, old, new, match):
 @pytest.mark.parametrize("effect,match", [
     ('effect = "rust"', "unknown effect 'rust'"),
     ('effect = "crack"\nposition = 0.9\ndepth_ratio = 0.5', "outside the structure"),
-    ('effect = "crack"\nposition = 0.2\ndepth_ratio = 1.5', "depth_ratio: must lie in"),
+    ('effect = "crack"\nposition = 0.2\ndepth_ratio = 1.5', "depth_ratio: must lie betw"),
     ('effect = "crack"\nposition = 0.2', "depth_ratio: missing"),
     ('effect = "support_spring"\nstiffness = 1.0\nside = "top"', "side: must be one of"),
 ])

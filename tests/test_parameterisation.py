@@ -5,7 +5,11 @@ import pytest
 import sympy
 
 from gfe_opt import elements as el
-from gfe_opt.parameterisation import beam_parameterisation, derive_nodal_coefficients
+from gfe_opt.parameterisation import (
+    beam_parameterisation,
+    derive_nodal_coefficients,
+    nodal_coefficients,
+)
 
 R = sympy.Rational
 
@@ -15,6 +19,8 @@ def test_eq13_coefficients_from_exact_integration():
     assert c == sympy.Matrix([[6, R(3, 5), 6, R(-3, 5)],
                               [R(21, 5), R(2, 5), R(9, 5), R(-1, 5)],
                               [R(16, 5), R(1, 3), R(4, 5), R(-2, 15)]])
+    # the quadrature the parameterisation uses at run time gives the same numbers
+    assert np.allclose(nodal_coefficients(), np.array(c, dtype=float), rtol=0, atol=1e-14)
 
 
 def test_eq23_linear_is_nodal_with_equal_slopes():

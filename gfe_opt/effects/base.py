@@ -1,0 +1,314 @@
+r"""What a physical effect is: one object that knows everything gfe-opt does with it.
+
+An :class:`EffectType` declares
+
+* its **parameters** (:class:`Parameter`: name, SI unit, the rule that checks a value, the
+  value at which the effect vanishes);
+* how it **changes the matrices**: :meth:`EffectType.contribute` tells a
+  :class:`~gfe_opt.assembly.Builder` to scale EI(x) or ρA(x), add a point mass or spring, an
+  element stiffness term or a support spring (the builder turns that into element matrices);
+* its **order-one variables** (:class:`Variable`: physical value = scale · z or
+  scale · 10^z, with bounds and a starting grid) for fitting;
+* its **realisation signature**: what it leaves in the continuous equation of a node;
+* its **marker** on the structure sketch of the figures.
+
+Effects are *global* (``material``, ``shear``, ``axial_load``, ``foundation``: at most one of
+each in a model) or *local* (any number of instances: two cracks are two ``crack`` entries).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from ..errors import GfeInputError
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A physical parameter of an effect.
+
+    ``rule`` is one of ``"position"`` (m, on the structure), ``"positive"`` (> 0),
+    ``"real"``, ``"fraction"`` (in (0, 1)), ``"range"`` (in [lower, upper]), ``"choice"``
+    (one of ``choices``), ``"knots"`` (increasing positions from one end to the other) or
+    ``"ratios"`` (a list of positive numbers, one per knot).  ``null`` is the value at which
+    the effect vanishes (``"inf"`` when it vanishes as the value grows, as a shear rigidity);
+    the size of a fitted effect is measured from it in standard deviations.
+    """
+
+    name: str
+    unit: str
+    rule: str
+    description: str
+    lower: float | None = None
+    upper: float | None = None
+    choices: tuple = ()
+    null: Any = None
+
+    def describe_range(self, model) -> str:
+        if self.rule == "position":
+            return f"0 to {model.length:g} m"
+        if self.rule == "positive":
+            return f"> 0 {self.unit}".strip()
+        if self.rule == "fraction":
+            return "between 0 and 1 (exclusive)"
+        if self.rule == "range":
+            return f"{self.lower:g} to {self.upper:g} {self.unit}".strip()
+        if self.rule == "choice":
+            return "one of " + ", ".join(self.choices)
+        if self.rule == "knots":
+            return f"increasing positions from 0 to {model.length:g} m"
+        if self.rule == "ratios":
+            return "positive numbers, one per knot"
+        return "a finite number"
+
+    def check(self, value, model, where: str, field: str):
+        """The value, validated (lists as lists of floats); raises :class:`GfeInputError`."""
+        if self.rule == "choice":
+            if value not in self.choices:
+                raise GfeInputError(where, field, f"must be {self.describe_range(model)}, "
+                                    f"got {value!r}")
+            return value
+        if self.rule in ("knots", "ratios"):
+            if not isinstance(value, (list, tuple)) or len(value) < 2:
+                raise GfeInputError(where, field, "must be a list of at least 2 numbers")
+            values = [as_float(v, where, f"{field}[{i}]") for i, v in enumerate(value)]
+            if self.rule == "ratios":
+                bad = [i for i, v in enumerate(values) if not 0.0 < v <= 100.0]
+                if bad:
+                    raise GfeInputError(where, f"{field}[{bad[0]}]", "must lie in (0, 100], "
+                                        f"got {values[bad[0]]:g}")
+            else:
+                tol = 1e-9 * model.length
+                if abs(values[0]) > tol or abs(values[-1] - model.length) > tol:
+                    raise GfeInputError(where, field, f"must run from 0 to {model.length:g} m "
+                                        f"(the whole structure), got {values[0]:g} to "
+                                        f"{values[-1]:g}")
+                if np.any(np.diff(values) <= 0):
+                    raise GfeInputError(where, field, "positions must increase")
+            return values
+        value = as_float(value, where, field)
+        if self.rule == "positive" and value <= 0:
+            raise GfeInputError(where, field, f"must be > 0 [{self.unit}], got {value:g}")
+        if self.rule == "fraction" and not 0.0 < value < 1.0:
+            raise GfeInputError(where, field, f"must lie between 0 and 1 (exclusive), "
+                                f"got {value:g}")
+        if self.rule == "range" and not self.lower <= value <= self.upper:
+            raise GfeInputError(where, field, f"must lie in [{self.lower:g}, {self.upper:g}]"
+                                f" {self.unit}, got {value:g}".rstrip())
+        if self.rule == "position" and not 0.0 <= value <= model.length:
+            raise GfeInputError(where, field, f"{value:g} m lies outside the structure "
+                                f"[0, {model.length:g}] m")
+        return value
+
+
+@dataclass(frozen=True)
+class Variable:
+    """An order-one fitting variable z of parameter ``key`` (element ``index`` of a list):
+    physical value = ``scale(model) * z`` or, with ``log``, ``scale(model) * 10**z``."""
+
+    key: str
+    lower: float
+    upper: float
+    grid: tuple
+    scale: Callable = lambda model: 1.0
+    log: bool = False
+    index: int | None = None
+
+    @property
+    def label(self) -> str:
+        return self.key if self.index is None else f"{self.key}[{self.index}]"
+
+    def physical(self, model, z: float) -> float:
+        s = self.scale(model)
+        return float(s * 10.0**z) if self.log else float(s * z)
+
+    def order_one(self, model, value: float) -> float:
+        s = self.scale(model)
+        if self.log:
+            return float(np.log10(value / s)) if value > 0 else self.lower
+        return float(value / s)
+
+
+def as_float(value, where, field) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise GfeInputError(where, field, f"must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise GfeInputError(where, field, f"must be finite, got {value}")
+    return value
+
+
+def no_unknown(tbl, known, where, prefix):
+    """Unknown keys are errors, with a "did you mean" hint."""
+    for key in tbl:
+        if key not in known:
+            close = difflib.get_close_matches(key, sorted(known), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise GfeInputError(where, prefix + key, f"unknown key{hint}")
+
+
+def nominal_rigidity(model) -> float:
+    """EI (beam) or EA (bar) of the model file's section and E, without effects [N m², N]:
+    the fixed scale of the order-one variables."""
+    return model.E * (model.inertia if model.kind == "beam" else model.area)
+
+
+class EffectType:
+    """Base class of every physical effect (see the module docstring).
+
+    Subclasses set the class attributes and override :meth:`contribute`; the rest has
+    defaults that fit most effects.
+    """
+
+    #: the name in model files, ``--add`` and JSON (a contract)
+    name: str = ""
+    #: one line of physics, shown in help and the README
+    physics: str = ""
+    #: what the effect leaves in the continuous equation of a node (paper, section 3)
+    signature: str = ""
+    #: "beam", "bar" or both
+    kinds: tuple = ("beam",)
+    #: local effects may repeat; global ones appear at most once
+    local: bool = False
+    #: proposed by ``diagnose`` unless the user chooses the candidates
+    candidate: bool = True
+    #: parameters (contract) and those fitted (the others, e.g. a side, are fixed per fit)
+    parameters: tuple = ()
+
+    # -- parameters -------------------------------------------------------------------
+    @property
+    def keys(self) -> tuple:
+        return tuple(p.name for p in self.parameters)
+
+    def parameter(self, key: str) -> Parameter:
+        return next(p for p in self.parameters if p.name == key)
+
+    def validate(self, model, params: dict, where: str, prefix: str = "",
+                 partial: bool = False) -> dict:
+        """Checked parameters (every key, or with ``partial`` those given); raises
+        :class:`GfeInputError` naming the field and the allowed range."""
+        if model.kind not in self.kinds:
+            raise GfeInputError(where, f"{prefix}effect", f"effect {self.name!r} needs kind = "
+                                f"{' or '.join(repr(k) for k in self.kinds)}")
+        no_unknown(params, set(self.keys), where, prefix)
+        out = {}
+        for p in self.parameters:
+            if p.name not in params:
+                if partial:
+                    continue
+                raise GfeInputError(where, f"{prefix}{p.name}",
+                                    f"missing ({self.name} needs {p.name} [{p.unit}])")
+            out[p.name] = p.check(params[p.name], model, where, f"{prefix}{p.name}")
+        self.check(model, out, where, prefix)
+        return out
+
+    def check(self, model, params: dict, where: str, prefix: str) -> None:
+        """Checks across parameters or against the model (override when needed)."""
+
+    # -- matrices ---------------------------------------------------------------------
+    def contribute(self, model, params: dict, build) -> None:
+        """Tell ``build`` (:class:`~gfe_opt.assembly.Builder`) how the effect changes the
+        structure."""
+        raise NotImplementedError
+
+    def youngs_modulus(self, params: dict, E: float) -> float:
+        """Young's modulus with this effect (only ``material`` changes it)."""
+        return E
+
+    # -- fitting ----------------------------------------------------------------------
+    def variables(self, model, fixed: dict) -> list[Variable]:
+        """Order-one variables for the fitted parameters (``fixed`` holds the others)."""
+        raise NotImplementedError
+
+    def fixed_keys(self) -> tuple:
+        """Parameters that are chosen, not fitted (e.g. a spring's side)."""
+        return tuple(p.name for p in self.parameters if p.rule in ("choice", "knots"))
+
+    def starts(self, model, hint: float) -> list[dict]:
+        """Starting parameter sets to try besides the grid (``hint`` = where the model
+        fails, x / length); each a dict of fixed and (some) fitted parameters."""
+        return [{}]
+
+    def to_physical(self, model, variables: list[Variable], z, fixed: dict) -> dict:
+        out = dict(fixed)
+        for v, value in zip(variables, z):
+            phys = v.physical(model, value)
+            if v.index is None:
+                out[v.key] = phys
+            else:
+                out.setdefault(v.key, [])
+                out[v.key].append(phys)
+        return {k: out[k] for k in self.keys if k in out}
+
+    def to_variables(self, model, variables: list[Variable], params: dict) -> np.ndarray:
+        out = []
+        for v in variables:
+            value = params[v.key] if v.index is None else params[v.key][v.index]
+            out.append(np.clip(v.order_one(model, value), v.lower, v.upper))
+        return np.array(out, dtype=float)
+
+    def size_in_sigmas(self, model, params: dict, sigma: dict) -> float:
+        """How far the fitted effect lies from 'no effect', in standard deviations: the
+        largest |value − null| / σ over the parameters that have a null value (a reciprocal
+        for null = "inf").  0 when the data do not determine it (σ infinite or unknown)."""
+        best = 0.0
+        for p in self.parameters:
+            if p.null is None or p.name not in params:
+                continue
+            values = np.atleast_1d(np.asarray(params[p.name], float))
+            sig = np.atleast_1d(np.asarray(sigma.get(p.name, np.inf), float))
+            null = model.E if p.null == "E" else p.null
+            if p.null == "inf":
+                z = values / sig  # 1/v from 0 in units of σ(1/v) = σ/v²
+            else:
+                z = np.abs(values - null) / sig
+            z = np.where(np.isfinite(z), z, 0.0)
+            best = max(best, float(np.max(z)))
+        return best
+
+    # -- what users see ---------------------------------------------------------------
+    def describe(self, params: dict, sigma: dict | None = None) -> str:
+        """``position = 0.190 ± 0.001 m, depth_ratio = 0.50 ± 0.01``."""
+        parts = []
+        for p in self.parameters:
+            if p.name not in params:
+                continue
+            parts.append(format_value(p, params[p.name], (sigma or {}).get(p.name)))
+        return ", ".join(parts)
+
+    def mark(self, ax, model, params: dict, sigma: dict | None, y: float) -> None:
+        """Draw the effect on the structure sketch (a matplotlib axis, x in m) at height y;
+        default: the name at mid-span for global effects."""
+        ax.annotate(self.name, (model.length / 2, y), textcoords="offset points",
+                    xytext=(0, 8), ha="center", fontsize=7, color="tab:red")
+
+    def position(self, params: dict) -> float | None:
+        """Where a local effect sits [m] (None for distributed ones)."""
+        return params.get("position")
+
+
+def format_value(p: Parameter, value, sigma=None) -> str:
+    """One parameter for people: 4 significant digits, ± σ, the unit."""
+    unit = f" {p.unit}" if p.unit and p.unit != "-" else ""
+    if isinstance(value, str):
+        return f"{p.name} = {value}"
+    if isinstance(value, (list, tuple)):
+        if sigma is not None and np.all(np.isfinite(sigma)):
+            inner = ", ".join(f"{v:.3g}±{s:.2g}" for v, s in zip(value, sigma))
+        else:
+            inner = ", ".join(f"{v:.4g}" for v in value)
+        return f"{p.name} = [{inner}]{unit}"
+    if sigma is None:
+        return f"{p.name} = {value:.4g}{unit}"
+    if not np.isfinite(sigma):
+        return f"{p.name} = {value:.4g}{unit} (not determined by the data)"
+    digits = max(0, -int(np.floor(np.log10(abs(sigma)))) + 1) if sigma > 0 else 4
+    if abs(value) >= 1e5 or (abs(value) < 1e-3 and value != 0):
+        return f"{p.name} = {value:.4g} ± {sigma:.2g}{unit}"
+    digits = min(digits, 8)
+    return f"{p.name} = {value:.{digits}f} ± {sigma:.{digits}f}{unit}"

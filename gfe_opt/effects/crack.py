@@ -1,0 +1,64 @@
+"""``crack``: a symmetric (double-edged) crack, Christides–Barr EI(x) = EI Q(x) (eq. 25)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import elements as el
+from ..errors import GfeInputError
+from .base import EffectType, Parameter, Variable
+
+#: Q(x) differs from 1 by less than 26 e^-36 (~1e-14) beyond 18 decay lengths
+CRACK_REACH = 18.0
+
+
+class Crack(EffectType):
+    name = "crack"
+    physics = ("EI(x) = EI Q(x), Christides–Barr disturbance with Shen–Pierre γ = 1.936; "
+               "exact-flexibility elements integrated through the crack zone")
+    signature = "a local drop of k, a few half-depths wide, and a rise of |k'| beside it"
+    local = True
+    parameters = (
+        Parameter("position", "m", "position", "distance of the crack from the left end"),
+        Parameter("depth_ratio", "-", "fraction", "a/d: depth of each cut over the "
+                  "half-depth d (Christides–Barr)", null=0.0),
+    )
+
+    def check(self, model, params, where, prefix):
+        if model.depth is None:
+            raise GfeInputError(where, f"{prefix}effect", "a crack needs the section depth "
+                                "(section.h or shape = 'rectangle')")
+        if params.get("depth_ratio", 0.0) > 0.95:
+            raise GfeInputError(where, f"{prefix}depth_ratio", "must lie between 0 and 0.95 "
+                                f"(a/d), got {params['depth_ratio']:g}")
+
+    def contribute(self, model, params, build):
+        x_c, ratio = params["position"], params["depth_ratio"]
+        half_depth = model.depth / 2.0
+        decay = half_depth / (2.0 * el.SHEN_PIERRE_GAMMA)
+
+        def q(x):
+            return el.christides_barr_q(x, x_c, ratio, half_depth)
+
+        build.scale_rigidity(q, breakpoints=(x_c,), refine_scale=decay,
+                             support=(x_c - CRACK_REACH * decay, x_c + CRACK_REACH * decay))
+
+    def variables(self, model, fixed):
+        return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
+                         scale=lambda m: m.length),
+                Variable("depth_ratio", 0.01, 0.9, (0.2, 0.45, 0.7))]
+
+    def starts(self, model, hint):
+        return [{}, {"position": hint * model.length, "depth_ratio": 0.45}]
+
+    def mark(self, ax, model, params, sigma, y):
+        x = params["position"]
+        ax.plot([x], [y], marker="v", color="tab:red", ms=9, zorder=5)
+        s = (sigma or {}).get("position")
+        if s is not None and np.isfinite(s):
+            ax.errorbar([x], [y], xerr=[2 * s], color="tab:red", capsize=3, lw=1)
+        ax.annotate(f"crack a/d {params['depth_ratio']:.2f}", (x, y), textcoords="offset "
+                    "points", xytext=(0, 9), ha="center", fontsize=7, color="tab:red")
+
+
+EFFECT = Crack()

@@ -1,0 +1,57 @@
+"""Shared form of the two profile effects (``stiffness_profile``, ``mass_profile``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import GfeInputError
+from .base import EffectType, Parameter, Variable
+
+#: knot counts diagnose tries, coarse to fine (each set contains the previous one)
+KNOT_COUNTS = (2, 3, 5, 9)
+
+
+def piecewise_linear(x_knots, ratios):
+    xk, rk = np.asarray(x_knots, float), np.asarray(ratios, float)
+
+    def f(x):
+        return np.interp(x, xk, rk)
+
+    return f
+
+
+class ProfileEffect(EffectType):
+    kinds = ("beam", "bar")
+    #: diagnose offers profiles when no named effect explains the data
+    fallback = True
+    #: "rigidity" or "mass": which distribution the ratio multiplies
+    quantity = ""
+    parameters = (
+        Parameter("x", "m", "knots", "knot positions, increasing, from one end to the other"),
+        Parameter("ratio", "-", "ratios", "value over the model's at each knot", null=1.0),
+    )
+
+    def check(self, model, params, where, prefix):
+        if "x" in params and "ratio" in params and len(params["x"]) != len(params["ratio"]):
+            raise GfeInputError(where, f"{prefix}ratio", f"has {len(params['ratio'])} values "
+                                f"for {len(params['x'])} knots")
+
+    def contribute(self, model, params, build):
+        f = piecewise_linear(params["x"], params["ratio"])
+        scale = build.scale_rigidity if self.quantity == "rigidity" else build.scale_mass
+        scale(f, breakpoints=tuple(params["x"][1:-1]))
+
+    def variables(self, model, fixed):
+        return [Variable("ratio", 0.05, 3.0, (1.0,), index=i) for i in range(len(fixed["x"]))]
+
+    def fixed_keys(self):
+        return ("x",)
+
+    def starts(self, model, hint):
+        return [{"x": list(np.linspace(0.0, model.length, k))} for k in KNOT_COUNTS]
+
+    def position(self, params):
+        return None
+
+    def mark(self, ax, model, params, sigma, y):
+        ax.plot(params["x"], [y] * len(params["x"]), "|", color="tab:brown", ms=8)

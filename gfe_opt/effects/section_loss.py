@@ -1,0 +1,68 @@
+"""``section_loss``: stiffness and mass lost together over a zone (corrosion, thinning,
+a wide notch)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import GfeInputError
+from .base import EffectType, Parameter, Variable
+
+
+def zone(centre: float, length: float, ratio: float):
+    """The multiplier ``ratio`` inside [centre − length/2, centre + length/2], 1 outside."""
+    a, b = centre - length / 2.0, centre + length / 2.0
+
+    def f(x):
+        return np.where((x >= a) & (x <= b), ratio, 1.0)
+
+    return f
+
+
+class SectionLoss(EffectType):
+    name = "section_loss"
+    physics = "EI and ρA multiplied by stiffness_ratio and mass_ratio over a zone"
+    signature = "a local drop of k over the zone's width and of the coefficient of ẅ"
+    kinds = ("beam", "bar")
+    local = True
+    parameters = (
+        Parameter("position", "m", "position", "centre of the zone"),
+        Parameter("length", "m", "positive", "length of the zone"),
+        Parameter("stiffness_ratio", "-", "range", "EI (bar: EA) inside over outside",
+                  lower=0.01, upper=10.0, null=1.0),
+        Parameter("mass_ratio", "-", "range", "ρA inside over outside", lower=0.01,
+                  upper=10.0, null=1.0),
+    )
+
+    def check(self, model, params, where, prefix):
+        if "length" in params and params["length"] > model.length:
+            raise GfeInputError(where, f"{prefix}length", f"{params['length']:g} m is longer "
+                                f"than the structure ({model.length:g} m)")
+
+    def contribute(self, model, params, build):
+        c, ell = params["position"], params["length"]
+        edges = (c - ell / 2.0, c + ell / 2.0)
+        build.scale_rigidity(zone(c, ell, params["stiffness_ratio"]), breakpoints=edges,
+                             support=edges)
+        build.scale_mass(zone(c, ell, params["mass_ratio"]), breakpoints=edges, support=edges)
+
+    def variables(self, model, fixed):
+        return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
+                         scale=lambda m: m.length),
+                Variable("length", 0.004, 0.3, (0.05,), scale=lambda m: m.length),
+                Variable("stiffness_ratio", 0.05, 3.0, (0.7,)),
+                Variable("mass_ratio", 0.05, 3.0, (1.0,))]
+
+    def starts(self, model, hint):
+        return [{}, {"position": hint * model.length, "length": 0.05 * model.length,
+                     "stiffness_ratio": 0.7, "mass_ratio": 1.0}]
+
+    def mark(self, ax, model, params, sigma, y):
+        c, ell = params["position"], params["length"]
+        ax.axvspan(c - ell / 2, c + ell / 2, color="tab:orange", alpha=0.35, lw=0)
+        ax.annotate(f"EI×{params['stiffness_ratio']:.2f}, ρA×{params['mass_ratio']:.2f}",
+                    (c, y), textcoords="offset points", xytext=(0, 9), ha="center",
+                    fontsize=7, color="tab:orange")
+
+
+EFFECT = SectionLoss()

@@ -1,0 +1,520 @@
+r"""Fitting the physical parameters of effects to measured modes (IPOPT, Gauss–Newton).
+
+Misfit
+------
+For a model, the lowest modes are paired with the measured ones by MAC (Hungarian,
+threshold 0.3) and the weighted residual is
+
+.. math:: χ^2 = \sum_j \Big(\frac{f_j/f_{t,j} - 1}{σ_f}\Big)^2
+        + \sum_j \sum_s \Big(\frac{\hat φ_{sj} - \hat y_{sj}}{σ_s \max_s|\hat y_{sj}|}\Big)^2
+
+with unit-norm, sign-aligned shapes at the sensors, σ_f the relative frequency noise and
+σ_s the shape noise relative to each mode's largest amplitude.  A measured mode with no
+partner costs :math:`(0.5/σ_f)^2`.  ``χ² per residual`` (χ²/n) is 1 for a model that fits
+to the stated noise (a little less after fitting p parameters: (n − p)/n).
+
+Fitting
+-------
+Every instance of an effect in the model is a *slot*: its fitted parameters are order-one
+variables (:class:`~gfe_opt.effects.Variable`, with bounds), its chosen ones (a spring's
+side, a profile's knots) are fixed.  Instances already in the model start where they are;
+added ones start from given values or from the best point of a coarse grid.  χ² is
+minimised by IPOPT through CasADi with a forward-difference Jacobian of the residual vector
+and the Gauss–Newton Hessian.
+
+Uncertainty
+-----------
+At the optimum, the Gauss–Newton covariance of the variables is
+:math:`s^2 (J^T J)^{-1}` with J the Jacobian of the normalised residuals and
+:math:`s^2 = \max(1, χ^2/(n-p))` (the stated noise, or more when the fit is worse than it);
+standard deviations of the physical parameters follow through the variable maps.  A
+parameter the data cannot determine (a mass on a pinned support) gets an infinite one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from .correlation import mac, pair_modes
+from .effects import EffectType, effect_type
+from .errors import GfeInputError, GfeSolverError
+from .measured import MeasuredModes, sensor_matrix
+from .modal import model_modes
+from .model import Effect, Model
+
+DEFAULT_FREQ_NOISE = 0.0005
+DEFAULT_SHAPE_NOISE = 0.003
+#: cost of a residual when the model cannot be solved (e.g. buckled by a compression)
+FAILED_RESIDUAL = 1e6
+
+
+@dataclass(frozen=True)
+class Noise:
+    """Relative noise of the measured frequencies and shapes; ``given`` when the user
+    stated it (otherwise these are assumptions and the data's own level is estimated)."""
+
+    freq: float = DEFAULT_FREQ_NOISE
+    shape: float = DEFAULT_SHAPE_NOISE
+    given: bool = False
+
+    def __post_init__(self):
+        for name, value in (("frequency noise", self.freq), ("shape noise", self.shape)):
+            if not 0.0 < value < 1.0:
+                raise GfeInputError(None, name, f"must lie between 0 and 1 (relative), got "
+                                    f"{value!r}: zero noise would make every difference "
+                                    "infinitely significant")
+
+
+def noise_of(freq_noise=None, shape_noise=None) -> Noise:
+    """A :class:`Noise` from optional values (both None: the defaults, not given)."""
+    given = freq_noise is not None or shape_noise is not None
+    return Noise(DEFAULT_FREQ_NOISE if freq_noise is None else float(freq_noise),
+                 DEFAULT_SHAPE_NOISE if shape_noise is None else float(shape_noise), given)
+
+
+# -------------------------------------------------------------------------------------------
+# Misfit
+# -------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Misfit:
+    """χ² of a model against measured modes, with the numbers users read."""
+
+    chi2: float
+    freq_error_rms_pct: float
+    mac_mean: float
+    n_residuals: int
+    chi2_freq: float = 0.0
+    n_freq: int = 0
+
+    @property
+    def chi2_per_residual(self) -> float:
+        return self.chi2 / self.n_residuals if self.n_residuals else float("inf")
+
+    def summary(self) -> dict:
+        """The JSON form (``baseline``, ``before``, ``after``)."""
+        return {"freq_error_rms_pct": self.freq_error_rms_pct, "mac_mean": self.mac_mean,
+                "chi2_per_residual": self.chi2_per_residual}
+
+
+def misfit(model: Model, measured: MeasuredModes, noise: Noise, C=None) -> Misfit:
+    """Weighted residual of ``model`` against ``measured`` (module docstring)."""
+    r, f_err, macs = residuals(model, measured, noise, C)
+    n = measured.n_modes * (1 + measured.n_sensors)
+    if r is None:
+        return Misfit(np.inf, np.inf, 0.0, n, np.inf, measured.n_modes)
+    freq = r.reshape(measured.n_modes, -1)[:, 0]
+    return Misfit(chi2=float(np.sum(r**2)),
+                  freq_error_rms_pct=float(100 * np.sqrt(np.mean(f_err**2))) if f_err.size
+                  else float("inf"),
+                  mac_mean=float(np.mean(macs)) if macs.size else 0.0, n_residuals=r.size,
+                  chi2_freq=float(np.sum(freq**2)), n_freq=measured.n_modes)
+
+
+def residuals(model, measured, noise: Noise, C=None):
+    """Fixed-length residual vector (per measured mode: frequency, then sensors), the
+    relative frequency errors and MACs of the pairs; ``(None, ...)`` if the solve fails."""
+    n_model = min(measured.n_modes + 4, _max_modes(model))
+    try:
+        modes = model_modes(model, n_model)
+    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+        return None, np.zeros(0), np.zeros(0)
+    if C is None:
+        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    shapes = C @ modes.shapes
+    mac_matrix = mac(measured.shapes, shapes)
+    pairs = pair_modes(np.nan_to_num(mac_matrix), 0.3, measured.frequencies_hz,
+                       modes.frequencies_hz)
+    rows = np.array([t for t, _ in pairs], dtype=int)
+    cols = np.array([m for _, m in pairs], dtype=int)
+    r = np.zeros((measured.n_modes, 1 + measured.n_sensors))
+    r[:, 0] = 0.5 / noise.freq  # an unpaired mode
+    f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
+    y = measured.shapes[:, rows] / np.linalg.norm(measured.shapes[:, rows], axis=0)
+    s = shapes[:, cols] / np.linalg.norm(shapes[:, cols], axis=0)
+    s = s * np.sign(np.sum(s * y, axis=0))
+    r[rows, 0] = f_err / noise.freq
+    r[rows, 1:] = ((s - y) / (noise.shape * np.max(np.abs(y), axis=0))).T
+    return r.ravel(), f_err, mac_matrix[rows, cols]
+
+
+def _max_modes(model: Model) -> int:
+    from .assembly import constrained_dofs
+
+    return model.n_dof - len(constrained_dofs(model)) - 1
+
+
+# -------------------------------------------------------------------------------------------
+# Slots: effect instances with their variables
+# -------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Slot:
+    """One effect instance in a fit: its type, fixed parameters, starting parameters and
+    order-one variables (none when it is held at ``start``)."""
+
+    effect: EffectType
+    fixed: dict
+    start: dict
+    variables: tuple
+    added: bool
+
+
+def slots_for(model: Model, adding) -> list[Slot]:
+    """Slots of the model's instances (re-estimated from where they are) and of the added
+    ones (``Effect`` with partial or no parameters).  An effect that is redundant with
+    another in the fit (E with a stiffness profile) is held."""
+    base = model.with_effects([], check=False)
+    entries = [(e, False) for e in model.effects] + [(e, True) for e in adding]
+    names = {e.name for e, _ in entries}
+    out = []
+    for e, added in entries:
+        kind = effect_type(e.name)
+        fixed = {k: e.parameters[k] for k in kind.fixed_keys() if k in e.parameters}
+        missing = [k for k in kind.fixed_keys() if k not in fixed]
+        if missing:
+            raise GfeInputError(None, e.name, f"needs {', '.join(missing)} to be fitted")
+        held = any(n in names for n in getattr(kind, "redundant_with", ()))
+        variables = () if held else tuple(kind.variables(base, fixed))
+        out.append(Slot(kind, fixed, dict(e.parameters), variables, added))
+    return out
+
+
+def n_variables(slots) -> int:
+    return sum(len(s.variables) for s in slots)
+
+
+# -------------------------------------------------------------------------------------------
+# The fit
+# -------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Fit:
+    """A model with fitted effects, its misfit and the uncertainty of every parameter.
+
+    ``effects`` are all instances of the fitted model in order; ``sigma`` holds one dict of
+    standard deviations per instance; ``added`` indexes the instance this fit was about
+    (None for a re-estimate of the present effects).  ``significant``, ``failed`` and
+    ``size_sigmas`` are set by the diagnosis.
+    """
+
+    name: str
+    effects: tuple
+    sigma: tuple
+    added: int | None
+    model: Model
+    misfit: Misfit
+    n_params: int
+    status: str
+    success: bool
+    evaluations: int
+    significant: bool = False
+    failed: bool = False
+    size_sigmas: float = 0.0
+    gain: float = 0.0          # χ² of the present effects alone minus this fit's
+    threshold: float = 0.0     # the gain it needed to be significant
+    notes: list = field(default_factory=list)
+
+    @property
+    def effect(self) -> str:
+        return self.name
+
+    @property
+    def parameters(self) -> dict:
+        return self.effects[self.added].parameters if self.added is not None else {}
+
+    @property
+    def uncertainty(self) -> dict:
+        return self.sigma[self.added] if self.added is not None else {}
+
+    def describe(self) -> str:
+        """``crack: position = 0.190 ± 0.001 m, depth_ratio = 0.50 ± 0.01``."""
+        if self.added is None:
+            return "present effects re-estimated"
+        return f"{self.name}: " + effect_type(self.name).describe(self.parameters,
+                                                                 self.uncertainty)
+
+    def to_json(self) -> dict:
+        out = {"effect": self.name, "parameters": jsonable(self.parameters),
+               "uncertainty": jsonable(self.uncertainty), **self.misfit.summary(),
+               "significant": self.significant}
+        return out
+
+
+def jsonable(params: dict) -> dict:
+    """Parameters with numpy values as floats, infinite σ as null (valid JSON)."""
+    def one(v):
+        if isinstance(v, (list, tuple, np.ndarray)):
+            return [one(x) for x in v]
+        if isinstance(v, str):
+            return v
+        v = float(v)
+        return v if np.isfinite(v) else None
+
+    return {k: one(v) for k, v in params.items()}
+
+
+def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Noise,
+                max_iter: int = 25, C=None, name: str | None = None,
+                alternatives=()) -> Fit:
+    """Fit the parameters of the model's effects and of ``adding`` (effects whose given
+    parameters are starting values; ``Effect(name, {})``: a grid chooses them).
+    ``alternatives`` are further starting parameter sets of the last added effect (same
+    fixed parameters): the best grid point over all of them starts IPOPT."""
+    base = model.with_effects([], check=False)
+    slots = slots_for(model, adding)
+    if C is None:
+        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    n_res = measured.n_modes * (1 + measured.n_sensors)
+    counter = {"n": 0}
+
+    def effects_of(z):
+        out, i = [], 0
+        for slot in slots:
+            k = len(slot.variables)
+            if k == 0:
+                out.append(Effect(slot.effect.name, slot.start))
+            else:
+                out.append(Effect(slot.effect.name, slot.effect.to_physical(
+                    base, slot.variables, z[i:i + k], slot.fixed)))
+            i += k
+        return out
+
+    def residual(z):
+        counter["n"] += 1
+        try:
+            trial = base.with_effects(effects_of(z), check=False)
+            r = residuals(trial, measured, noise, C)[0]
+        except (GfeInputError, ValueError, FloatingPointError, np.linalg.LinAlgError):
+            r = None
+        return np.full(n_res, FAILED_RESIDUAL) if r is None else r
+
+    def chi2(z):
+        return float(np.sum(residual(z) ** 2))
+
+    lower = np.array([v.lower for s in slots for v in s.variables])
+    upper = np.array([v.upper for s in slots for v in s.variables])
+    # a given value is the only grid point of its variable; the others use their grid
+    def grid_of(slot, start):
+        return [(v.order_one(base, _value(start, v)),) if _has(start, v) else v.grid
+                for v in slot.variables]
+
+    grids = [grid_of(slot, slot.start) for slot in slots]
+    z_start = np.clip(_grid_start(chi2, grids), lower, upper)
+    if alternatives:
+        best = chi2(z_start)
+        for alt in alternatives:
+            trial = np.clip(_grid_start(chi2, grids[:-1] + [grid_of(slots[-1], alt)]),
+                            lower, upper)
+            value = chi2(trial)
+            if value < best:
+                best, z_start = value, trial
+    n = z_start.size
+    status, success = "Nothing_To_Fit", True
+    z = z_start
+    if n:
+        chi2_start = chi2(z_start)
+        scale = np.sqrt(max(chi2_start, 1.0))  # objective starts at 1/2: relative tolerances
+        r_fun = _Residual(lambda zz: residual(zz) / scale, n, n_res)
+        x = ca.MX.sym("z", n)
+        solver = ca.nlpsol("effects", "ipopt", {"x": x, "f": 0.5 * ca.sumsqr(r_fun(x))},
+                           {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
+                            "ipopt.max_iter": max_iter, "ipopt.tol": 1e-3,
+                            # measured: the adaptive barrier halves the evaluations
+                            "ipopt.mu_strategy": "adaptive",
+                            # finite-difference gradients carry ~1e-6 relative noise: stop
+                            # when the objective no longer moves rather than chase them
+                            "ipopt.acceptable_tol": 1e-1, "ipopt.acceptable_iter": 2,
+                            "ipopt.acceptable_obj_change_tol": 1e-7})
+        sol = solver(x0=z_start, lbx=lower, ubx=upper)
+        stats = solver.stats()
+        z = np.array(sol["x"]).ravel()
+        if chi2(z) > chi2_start:  # never return worse than the start
+            z = z_start
+        status = str(stats.get("return_status"))
+        success = bool(stats.get("success")) or status in ("Solved_To_Acceptable_Level",
+                                                           "Maximum_Iterations_Exceeded")
+    effects = effects_of(z)
+    fitted = base.with_effects(effects, check=False)
+    fit_misfit = misfit(fitted, measured, noise, C)
+    sigma = _uncertainty(residual, z, slots, base, fit_misfit, lower, upper)
+    added = [i for i, s in enumerate(slots) if s.added]
+    return Fit(name=name or (slots[added[0]].effect.name if added else "baseline"),
+               effects=tuple(effects), sigma=tuple(sigma), added=added[0] if added else None,
+               model=fitted, misfit=fit_misfit, n_params=n, status=status,
+               success=success and np.isfinite(fit_misfit.chi2), evaluations=counter["n"])
+
+
+def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper) -> list[dict]:
+    """Standard deviations of every slot's physical parameters (Gauss–Newton)."""
+    n = z.size
+    out = [{} for _ in slots]
+    if n == 0 or not np.isfinite(fit_misfit.chi2):
+        return out
+    r0 = residual(z)
+    J = np.zeros((r0.size, n))
+    for k in range(n):
+        h = 1e-6 * max(1.0, abs(z[k]))
+        if z[k] + h > upper[k]:
+            h = -h
+        dz = z.copy()
+        dz[k] += h
+        J[:, k] = (residual(dz) - r0) / h
+    A = J.T @ J
+    ridge = 1e-12 * max(float(np.max(np.diag(A))), 1e-300)
+    s2 = max(1.0, fit_misfit.chi2 / max(fit_misfit.n_residuals - n, 1))
+    try:
+        cov = s2 * np.linalg.inv(A + ridge * np.eye(n))
+    except np.linalg.LinAlgError:
+        cov = np.full((n, n), np.inf)
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    sd = np.where(np.diag(A) > 1e-9 * max(float(np.max(np.diag(A))), 1e-300), sd, np.inf)
+    i = 0
+    for j, slot in enumerate(slots):
+        for v in slot.variables:
+            phys = v.physical(base, z[i])
+            derivative = phys * np.log(10.0) if v.log else v.scale(base)
+            value = abs(derivative) * sd[i]
+            if v.index is None:
+                out[j][v.key] = float(value)
+            else:
+                out[j].setdefault(v.key, []).append(float(value))
+            i += 1
+    return out
+
+
+def _has(start: dict, v) -> bool:
+    if v.key not in start:
+        return False
+    return v.index is None or (isinstance(start[v.key], (list, tuple))
+                               and len(start[v.key]) > v.index)
+
+
+def _value(start: dict, v) -> float:
+    return start[v.key] if v.index is None else start[v.key][v.index]
+
+
+def _grid_start(chi2, grids):
+    """Best point of a coarse grid: each slot's grid (the product of its variables' grids)
+    searched with the other slots at their current point."""
+    current = [np.array([g[0] for g in slot], dtype=float) for slot in grids]
+    if not current:
+        return np.zeros(0)
+    for i, slot in enumerate(grids):
+        if all(len(g) == 1 for g in slot):
+            continue
+        points = np.array(np.meshgrid(*slot, indexing="ij")).reshape(len(slot), -1).T
+        best, best_point = np.inf, points[0]
+        for point in points:
+            trial = list(current)
+            trial[i] = point
+            value = chi2(np.concatenate(trial))
+            if value < best:
+                best, best_point = value, point
+        current[i] = best_point
+    return np.concatenate(current)
+
+
+# -------------------------------------------------------------------------------------------
+# CasADi callbacks: residual with a forward-difference Jacobian, Gauss–Newton Hessian
+# -------------------------------------------------------------------------------------------
+
+
+class _Residual(ca.Callback):
+    """r(z) as a CasADi function with a forward-difference Jacobian whose own derivative is
+    zero, so IPOPT's exact-Hessian mode on ½‖r‖² performs Gauss–Newton steps."""
+
+    def __init__(self, fun, n: int, m: int, step: float = 1e-6):
+        ca.Callback.__init__(self)
+        self.fun, self.n, self.m, self.step = fun, n, m, step
+        self.construct("residual", {})
+
+    def get_n_in(self):
+        return 1
+
+    def get_n_out(self):
+        return 1
+
+    def get_sparsity_in(self, i):
+        return ca.Sparsity.dense(self.n, 1)
+
+    def get_sparsity_out(self, i):
+        return ca.Sparsity.dense(self.m, 1)
+
+    def eval(self, arg):
+        return [self.fun(np.array(arg[0]).ravel())]
+
+    def has_jacobian(self):
+        return True
+
+    def get_jacobian(self, name, inames, onames, opts):
+        self._jacobian = _ForwardDifference(name, self)
+        return self._jacobian
+
+
+class _ForwardDifference(ca.Callback):
+    def __init__(self, name, outer: _Residual):
+        ca.Callback.__init__(self)
+        self.outer = outer
+        self.construct(name, {})
+
+    def get_n_in(self):
+        return 2
+
+    def get_n_out(self):
+        return 1
+
+    def get_sparsity_in(self, i):
+        return ca.Sparsity.dense(self.outer.n if i == 0 else self.outer.m, 1)
+
+    def get_sparsity_out(self, i):
+        return ca.Sparsity.dense(self.outer.m, self.outer.n)
+
+    def eval(self, arg):
+        z, r0 = np.array(arg[0]).ravel(), np.array(arg[1]).ravel()
+        jac = np.zeros((self.outer.m, self.outer.n))
+        for k in range(self.outer.n):
+            dz = z.copy()
+            h = self.outer.step * max(1.0, abs(z[k]))
+            dz[k] += h
+            jac[:, k] = (self.outer.fun(dz) - r0) / h
+        return [jac]
+
+    def has_jacobian(self):
+        return True
+
+    def get_jacobian(self, name, inames, onames, opts):
+        self._zero = _Zero(name, self.outer.n, self.outer.m)
+        return self._zero
+
+
+class _Zero(ca.Callback):
+    """The (neglected) second derivative of the residual: Gauss–Newton."""
+
+    def __init__(self, name, n, m):
+        ca.Callback.__init__(self)
+        self.n, self.m = n, m
+        self.construct(name, {})
+
+    def get_n_in(self):
+        return 3
+
+    def get_n_out(self):
+        return 2
+
+    def get_sparsity_in(self, i):
+        return [ca.Sparsity.dense(self.n, 1), ca.Sparsity.dense(self.m, 1),
+                ca.Sparsity.dense(self.m, self.n)][i]
+
+    def get_sparsity_out(self, i):
+        return ca.Sparsity(self.m * self.n, self.n if i == 0 else self.m)
+
+    def eval(self, arg):
+        return [ca.DM(ca.Sparsity(self.m * self.n, self.n)),
+                ca.DM(ca.Sparsity(self.m * self.n, self.m))]

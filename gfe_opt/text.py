@@ -1,0 +1,135 @@
+"""The words gfe-opt prints: a comparison, a diagnosis and an update as text.
+
+One function per result, used by the command line, the demo and the HTML report, so the
+API, the terminal and the report say the same thing from the same result object.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from .effects import effect_type
+
+SPARK = " ▁▂▃▄▅▆▇█"
+
+VERDICT_WORDS = {
+    "consistent": "the model agrees with the test within the noise; nothing to add",
+    "effect_found": "an effect is missing",
+    "unexplained": "none of the effects I know explains the difference",
+}
+
+
+def misfit_line(m, label: str = "") -> str:
+    """``frequency error 5.591 % rms, mean MAC 0.9919, χ²/n 663.6``."""
+    head = f"{label}: " if label else ""
+    return (f"{head}frequency error {m.freq_error_rms_pct:.3f} % rms, mean MAC "
+            f"{m.mac_mean:.4f}, χ²/n {_ratio(m.chi2_per_residual)}")
+
+
+def _ratio(value: float) -> str:
+    if not np.isfinite(value):
+        return "inf"
+    return f"{value:.3g}" if value < 1000 else f"{value:.0f}"
+
+
+def format_comparison(result, length: float) -> str:
+    """Paired modes and where along the structure the model fails."""
+    lines = [f"{'mode':>4}  {'f_test [Hz]':>12}  {'f_model [Hz]':>12}  {'Δf %':>8}  {'MAC':>6}"]
+    for p in result.pairs:
+        lines.append(f"{p.test_mode:>4}  {p.test_hz:12.2f}  {p.model_hz:12.2f}  "
+                     f"{p.error_pct:+8.2f}  {p.mac:6.3f}")
+    for t in result.unpaired_test_modes:
+        lines.append(f"{t + 1:>4}  (no model mode with MAC >= threshold)")
+    lines.append(f"frequency error (rms) {result.freq_error_rms_pct:.2f} %, "
+                 f"mean MAC {result.mac_mean:.3f}")
+    places = result.failure_places()
+    lines.append("")
+    if not places:
+        lines.append("no residual force: the model reproduces the measured shapes")
+        lines.extend(f"note: {n}" for n in result.notes)
+        return "\n".join(lines)
+    r = result.residual / result.residual.max()
+    spark = "".join(SPARK[int(round(v * (len(SPARK) - 1)))] for v in r)
+    lines.append("residual force along the structure (left end -> right end):")
+    lines.append(f"  |{spark}|")
+    x0, _ = places[0]
+    lines.append(f"the model fails most near x = {x0:.3f} m ({100 * x0 / length:.0f} % of the "
+                 "length)")
+    for x, rel in places[1:]:
+        lines.append(f"  also near x = {x:.3f} m ({100 * x / length:.0f} %), "
+                     f"{100 * rel:.0f} % of the largest residual")
+    lines.extend(f"note: {n}" for n in result.notes)
+    return "\n".join(lines)
+
+
+def format_diagnosis(result, model) -> str:
+    """The ranking, the verdict in words, the effect found ± its uncertainty, what the
+    generic-element update shows and the noise the data imply."""
+    now = result.current
+    lines = [misfit_line(result.baseline, "the model as it stands")]
+    if result.reference is not None:
+        lines.append(misfit_line(now, "its effects re-estimated"))
+    lines += ["", "candidates, best first (Δχ² must exceed 'needed' and the effect must lie "
+              "3 σ from nothing):",
+              f"{'rank':>4}  {'effect':<18} {'χ²/n':>8} {'f err %':>8} {'MAC':>7} "
+              f"{'Δχ²':>9} {'needed':>8} {'size σ':>7}  significant"]
+    for i, f in enumerate(result.fits, 1):
+        lines.append(f"{i:>4}  {f.name:<18} {_ratio(f.misfit.chi2_per_residual):>8} "
+                     f"{f.misfit.freq_error_rms_pct:8.3f} {f.misfit.mac_mean:7.4f} "
+                     f"{_ratio(f.gain):>9} {_ratio(f.threshold):>8} "
+                     f"{min(f.size_sigmas, 999):7.1f}  {'yes' if f.significant else 'no'}")
+    if result.failed:
+        lines.append("failed fits (worse than the model without them, or the solver "
+                     "stopped): " + ", ".join(f"{f.name} ({f.status})" for f in result.failed))
+    lines += ["", "verdict: " + VERDICT_WORDS[result.verdict]]
+    best = result.best
+    if best is not None:
+        lines.append(f"  {best.describe()}")
+        lines.append(f"  frequency error {now.freq_error_rms_pct:.3f} % -> "
+                     f"{best.misfit.freq_error_rms_pct:.3f} %, χ²/n "
+                     f"{_ratio(now.chi2_per_residual)} -> "
+                     f"{_ratio(best.misfit.chi2_per_residual)}")
+        lines.append(f"  add it: gfe-opt update MODEL MEASURED --add {best.name}")
+    elif result.verdict == "unexplained":
+        lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 fits to the noise); where "
+                     "the model fails: " + ", ".join(f"x = {x:.3f} m" for x, _ in
+                                                     result.localisation))
+    for word in result.realisation:
+        lines.append(f"the generic-element update (nodal k_i): {word}")
+    lines += [f"note: {n}" for n in result.notes]
+    lines.append(f"({result.seconds:.1f} s)")
+    return "\n".join(lines)
+
+
+def format_update(outcome) -> str:
+    """Before, every effect of the updated model with its uncertainty, after."""
+    lines = [misfit_line(outcome.before, "before")]
+    for i, (e, sigma) in enumerate(zip(outcome.fit.effects, outcome.fit.sigma)):
+        mark = "added" if i in outcome.added else "re-estimated"
+        lines.append(f"  {e.name} ({mark}): {effect_type(e.name).describe(e.parameters, sigma)}")
+    lines.append(misfit_line(outcome.after, "after"))
+    return "\n".join(lines)
+
+
+def format_parameters(params: dict) -> str:
+    """``position=0.19, depth_ratio=0.5`` (no uncertainty)."""
+    def one(v):
+        if isinstance(v, (list, tuple)):
+            return "[" + ", ".join(f"{x:.4g}" for x in v) + "]"
+        return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+    return ", ".join(f"{k}={one(v)}" for k, v in params.items())
+
+
+def terminal_progress(enabled: bool = True):
+    """A one-line progress report on stderr when it is a terminal (else None)."""
+    if not (enabled and sys.stderr.isatty()):
+        return None
+
+    def report(done, total, name):
+        end = "\n" if done == total else ""
+        print(f"\rfitting: {done}/{total} {name:<28}", end=end, file=sys.stderr, flush=True)
+
+    return report
