@@ -427,25 +427,54 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     notes = []
     words = nodal = None
     best = _best(fits, sel)
-    need_profile = fallback_names and not fits_noise(
-        best.misfit if best else ref_misfit, best.n_params if best else ref_params)
-    if need_profile:
-        profile = _fallback(model, measured, noise, fallback_names, sel, band, progress)
+
+    def explains(fit) -> bool:
+        """Brings the misfit to the noise: the stated one, or with no noise given, residuals
+        that look like noise (uncorrelated from sensor to sensor, frequencies within a
+        test's precision)."""
+        if fits_noise(fit.misfit, fit.n_params):
+            return True
+        if noise.given:
+            return False
+        return (abs(shape_correlation(fit.model, measured, noise, C)) < WHITE_NOISE_CORRELATION
+                and fit.misfit.chi2_freq / max(fit.misfit.n_freq, 1) <= FREQ_NOISE_LIMIT**2)
+
+    partial = None
+    if best is not None and not explains(best) or best is None and not fits_noise(
+            ref_misfit, ref_params):
+        profile = (_fallback(model, measured, noise, fallback_names, sel, band, progress)
+                   if fallback_names else None)
         if profile is not None:
             sel.floor = _floor([*fits, reference, profile])
             _judge([*fits, profile], sel, material, model)
             best = _best(fits, sel)
-            if best is not None and sel.better(profile, best, 1.0 - SIGNIFICANCE_LEVEL):
-                pair = _lookahead(model, measured, noise, best, fits, hint, profile, sel)
-                if pair is not None:
-                    notes.append(f"{best.name} with a further {pair.name} explains the data as "
-                                 f"well as a free {profile.name}: add them one at a time")
-                    profile.significant = False  # named effects win where they explain
-                elif profile.significant:
-                    notes.append(f"{best.name} explains part of the difference; a "
-                                 f"{profile.name} explains significantly more")
-                    best.significant = False
             fits.append(profile)
+        if best is not None and not explains(best):
+            pair = _lookahead(model, measured, noise, best, fits, hint, explains)
+            if pair is not None:
+                notes.append(f"{best.name} with a further {pair.name} brings the misfit to the "
+                             f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}): add them one "
+                             "at a time")
+                if profile is not None:
+                    profile.significant = False  # named effects win where they explain
+            elif profile is not None and profile.significant and explains(profile):
+                notes.append(f"{best.name} explains part of the difference; the "
+                             f"{profile.name} explains it to the noise")
+                best.significant = False
+            else:  # no finding: what explains less than the best does not explain either
+                partial = best
+                for f in fits:
+                    f.significant = False
+        if profile is not None and profile.significant and not explains(profile):
+            if partial is None and (best is None or not best.significant):
+                partial = profile
+            profile.significant = False  # a profile that does not explain is no finding
+        if partial is not None:
+            notes.append(f"{partial.name} explains part of the difference (χ²/n "
+                         f"{ref_misfit.chi2_per_residual:.3g} -> "
+                         f"{partial.misfit.chi2_per_residual:.3g}: {partial.describe()}), but "
+                         "neither it, nor it with one more effect, nor a free profile brings "
+                         "the misfit to the noise")
     ranked = [f for f in fits if not f.failed]
     ranked.sort(key=lambda f: (not f.significant, sel.penalised(f)))
     failed = [f for f in fits if f.failed]
@@ -524,23 +553,19 @@ def _generic_ratio(band, model, x):
     return list(np.clip(values, 0.06, 2.9))
 
 
-def _lookahead(model, measured, noise, best, fits, hint, profile, sel):
-    """``best`` with one more effect: the next candidates by χ², and a further instance of
-    ``best`` when it is local.  Returns the first pair that explains the data as well as
-    ``profile`` (not significantly worse, or within the noise), else None."""
+def _lookahead(model, measured, noise, best, fits, hint, explains):
+    """``best`` with one more effect: every other candidate that fitted, and a further
+    instance of ``best`` when it is local.  Returns the simplest pair that ``explains`` the data (χ²
+    plus the pair's parameter count as a tie-break), else None."""
     others = [f for f in sorted(fits, key=lambda f: f.misfit.chi2)
-              if f is not best and not f.failed and f.name != best.name][:3]
+              if f is not best and not f.failed and f.name != best.name
+              and not getattr(effect_type(f.name), "fallback", False)]
     seconds = ([best.name] if effect_type(best.name).local else []) + [f.name for f in others]
     first = Effect(best.name, best.parameters)
     jobs = [("candidate", (model, measured, name, noise, hint, None, (first,)))
             for name in seconds]
-    pairs = _run_jobs(jobs, None, seconds)
-    for pair in sorted(pairs, key=lambda f: f.misfit.chi2 + sel.floor * quantile(
-            f.n_params, sel.alpha(f.name))):
-        if fits_noise(pair.misfit, pair.n_params) or not sel.better(
-                profile, pair, 1.0 - SIGNIFICANCE_LEVEL):
-            return pair
-    return None
+    pairs = [p for p in _run_jobs(jobs, None, seconds) if p.success and explains(p)]
+    return min(pairs, key=lambda f: (f.n_params, f.misfit.chi2), default=None)
 
 
 def _generic_update(model, measured, noise):
@@ -705,9 +730,10 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
             places = compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
             hint = places[0][0] / model.length if places else 0.5
         where = e.parameters.get("position")
+        # fitted on top of the instances added before it: a second crack finds the second
         single = _fit_candidate(model, measured, e.name, noise,
                                 where / model.length if where is not None else hint,
-                                given=e.parameters)
+                                given=e.parameters, extra=tuple(starts))
         starts.append(Effect(e.name, {**single.parameters, **e.parameters}))
     fit = fit_effects(model, measured, starts, noise=noise, C=C,
                       name=" + ".join(e.name for e in effects))

@@ -302,8 +302,8 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     upper = np.array([v.upper for s in slots for v in s.variables])
     # a given value is the only grid point of its variable; the others use their grid
     def grid_of(slot, start):
-        return [(v.order_one(base, _value(start, v)),) if _has(start, v) else v.grid
-                for v in slot.variables]
+        return [(v.order_one(base, _value(start, v)),) if _has(start, v)
+                else _with_null(slot.effect, v, base) for v in slot.variables]
 
     grids = [grid_of(slot, slot.start) for slot in slots]
     z_start = np.clip(_grid_start(chi2, grids), lower, upper)
@@ -387,6 +387,21 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper) -> list[dic
                 out[j].setdefault(v.key, []).append(float(value))
             i += 1
     return out
+
+
+def _with_null(effect: EffectType, v, base) -> tuple:
+    """The variable's grid and the point where the effect vanishes (clipped to the bounds):
+    a fit can always fall back to about nothing, never end worse than without the effect."""
+    null = effect.parameter(v.key).null
+    if null is None:
+        return v.grid
+    if null == "inf":
+        z = v.upper
+    else:
+        value = base.E if null == "E" else float(null)
+        z = v.lower if v.log and value <= 0 else v.order_one(base, value)
+    z = float(np.clip(z, v.lower, v.upper))
+    return v.grid if any(abs(z - g) < 1e-12 for g in v.grid) else (z, *v.grid)
 
 
 def _has(start: dict, v) -> bool:
