@@ -18,7 +18,11 @@
 Parameter errors are max |k_i / k_true - 1| over the interior nodes and over the middle 90 %
 of the span (next to a pinned end the bending moment vanishes, k_i is barely determined and
 the regularisation holds it at its initial value).
-5. `diagnose` on the 46-element demo beam with 5 modes: wall time.
+5. `gfe-opt diagnose` (with the generic-update realisation, as the command runs it) on the
+   46-element demo beam with 5 modes, every candidate effect: wall time of the first diagnosis
+   and of the check after the crack is added (best and all of 3 runs).
+
+``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose.
 """
 
 import argparse
@@ -85,17 +89,32 @@ def _in_process(n, weighting="rows"):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-elements", type=int, default=10000)
+    parser.add_argument("--parts", default="update,ratio,solvers,accuracy,diagnose")
     args = parser.parse_args()
+    parts = set(args.parts.split(","))
     out = {}
     sizes = [n for n in (100, 300, 1000, 3000, 10000) if n <= args.max_elements]
-    rows = [_in_process(n) for n in sizes]
-    slope = float(np.polyfit(np.log([r["elements"] for r in rows]),
-                             np.log([r["seconds"] for r in rows]), 1)[0])
-    out["update_scaling"] = {"rows": rows, "loglog_slope": slope, "target": "<= 1.2"}
+    rows = [_in_process(n) for n in sizes] if "update" in parts else []
+    if rows:
+        slope = float(np.polyfit(np.log([r["elements"] for r in rows]),
+                                 np.log([r["seconds"] for r in rows]), 1)[0])
+        out["update_scaling"] = {"rows": rows, "loglog_slope": slope, "target": "<= 1.2"}
+    if "ratio" in parts:
+        _ratio(out)
+    if "solvers" in parts:
+        _solvers(out)
+    if "accuracy" in parts:
+        _accuracy(out, rows, sizes)
+    if "diagnose" in parts:
+        _diagnose(out)
+    print(json.dumps(out, indent=1))
 
+
+def _ratio(out):
     from gfe_opt.modal import model_modes
     from gfe_opt.parameterisation import derive_nodal_coefficients
     from gfe_opt.updating import update_generic
+
 
     derive_nodal_coefficients()
     model, measured, truth = _taper_problem(2000)
@@ -112,8 +131,10 @@ def main():
                          "status": result.status, "steps": result.stats.get("steps")}
     out["update_over_eigensolve_N2000"] = ratio
 
+
+def _solvers(out):
     from gfe_opt.output_error import update_output_error
-    from gfe_opt.updating import update_sdp
+    from gfe_opt.updating import update_generic, update_sdp
 
     def forced_ipopt(*args, **kwargs):
         return update_generic(*args, solver="ipopt", **kwargs)
@@ -138,6 +159,9 @@ def main():
                       "output_error_over_auto_time_N200": oe / by[(200, "auto")]["seconds"],
                       "target": "ipopt >= 50x faster with equal or better accuracy"}
 
+
+def _accuracy(out, rows, sizes):
+    from gfe_opt.modal import model_modes
     from gfe_opt.model import load_model
     from gfe_opt.problems import problem_file
 
@@ -152,18 +176,30 @@ def main():
                                   (r for r in rows if r["elements"] == 10000), None),
                               "update_energy_weighting": energy}
 
-    from gfe_opt.diagnosis import diagnose
-    from gfe_opt.model import Effect
+
+
+def _diagnose(out):
+    from gfe_opt.diagnosis import diagnose, update
+    from gfe_opt.model import Effect, load_model
+    from gfe_opt.problems import problem_file
     from gfe_opt.synthetic import interior_sensors, synthetic_measurement
 
     model = load_model(problem_file("ss-steel-beam.toml"))
     truth = model.with_effects([Effect("crack", {"position": 0.19, "depth_ratio": 0.5})])
     measured = synthetic_measurement(truth, 5, interior_sensors(model.length, 45),
-                                     shape_noise=0.003, freq_noise=0.0005, seed=1)
-    start = time.perf_counter()
-    diagnose(model, measured)
-    out["diagnose_46_elements_s"] = {"seconds": time.perf_counter() - start, "target": "< 3"}
-    print(json.dumps(out, indent=1))
+                                     shape_noise=0.003, freq_noise=0.0005, seed=2002)
+    noise = {"freq_noise": 0.0005, "shape_noise": 0.003}
+    updated = update(model, measured, ["crack"], **noise).model
+    result = {}
+    for label, m in (("first", model), ("after_adding_the_crack", updated)):
+        runs = []
+        for _ in range(REPEATS):
+            start = time.perf_counter()
+            d = diagnose(m, measured, realise=True, **noise)
+            runs.append(time.perf_counter() - start)
+        result[label] = {"best_s": min(runs), "runs_s": runs, "verdict": d.verdict,
+                         "candidates": len(d.fits) + len(d.failed)}
+    out["diagnose_46_elements"] = {**result, "target": "first < 3 s"}
 
 
 if __name__ == "__main__":
