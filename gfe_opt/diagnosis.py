@@ -181,7 +181,8 @@ class Diagnosis:
                 "noise": self.noise.to_json(),
                 "effects": [f.to_json() for f in self.fits],
                 "failed": [{"effect": f.name, "status": f.status,
-                            **f.misfit.summary()} for f in self.failed],
+                            "reason": "; ".join(f.notes), **f.misfit.summary()}
+                           for f in self.failed],
                 "skipped": [{"effect": name, "reason": reason} for name, reason in self.skipped],
                 "realisation": list(self.realisation),
                 "notes": list(self.notes)}
@@ -418,6 +419,10 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     for f in fits:
         # worse than the model without it (beyond rounding): a failed fit, not a candidate
         f.failed = (not f.success) or f.misfit.chi2 > ref_misfit.chi2 * (1 + 1e-4) + 0.5
+        if f.failed:
+            f.notes.append(f"solver: {f.status}" if not f.success else
+                           f"at best χ²/n {f.misfit.chi2_per_residual:.4g}, worse than "
+                           "without it")
     sel = _Selection(ref_misfit.chi2, ref_params, len(fits) + len(fallback_names),
                      measured.n_modes)
     sel.floor = _floor([*fits, reference])

@@ -81,8 +81,8 @@ def format_diagnosis(result, model) -> str:
                      f"{_ratio(f.gain):>9} {_ratio(f.threshold):>8} "
                      f"{min(f.size_sigmas, 999):7.1f}  {'yes' if f.significant else 'no'}")
     if result.failed:
-        lines.append("failed fits (worse than the model without them, or the solver "
-                     "stopped): " + ", ".join(f"{f.name} ({f.status})" for f in result.failed))
+        lines.append("failed fits, not ranked: " + "; ".join(
+            f"{f.name} ({'; '.join(f.notes)})" for f in result.failed))
     lines += ["", "verdict: " + VERDICT_WORDS[result.verdict]]
     best = result.best
     if best is not None:
