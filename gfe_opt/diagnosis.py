@@ -27,7 +27,8 @@ when
 3. for effects other than ``material``: it explains more than the best uniform change of E
    by the same margin (a uniform change is not called a crack).
 
-Candidates are ranked by χ² plus their own threshold (the simpler effect wins a tie).
+Candidates are ranked by the Bayesian information criterion χ²/s² + p ln n (the simpler
+effect wins unless the other fits better by ln n per extra parameter).
 
 Named effects first, profiles when nothing named suffices
 ---------------------------------------------------------
@@ -61,7 +62,6 @@ from scipy.special import chdtri
 
 from .correlation import compare
 from .effects import candidate_names, effect_type
-from .effects.profile import KNOT_COUNTS
 from .errors import GfeInputError, GfeSolverError
 from .fitting import (
     DEFAULT_FREQ_NOISE,
@@ -144,8 +144,8 @@ class NoiseEstimate:
 class Diagnosis:
     """Ranked candidate effects (best first), the verdict and what the data imply.
 
-    ``fits`` holds the candidates that were fitted (significant first, then by χ² plus
-    threshold); ``failed`` those whose fit failed or ended worse than the model without
+    ``fits`` holds the candidates that were fitted (significant first, then by the
+    information criterion); ``failed`` those whose fit failed or ended worse than the model without
     them; ``skipped`` candidates that could not be fitted, with the reason.
     """
 
@@ -198,7 +198,7 @@ def fitted_parameter_count(name: str) -> int:
     chosen; a profile is counted by its smallest knot set)."""
     kind = effect_type(name)
     if getattr(kind, "fallback", False):
-        return KNOT_COUNTS[0]
+        return kind.knot_counts[0]
     return len([p for p in kind.parameters if p.name not in kind.fixed_keys()])
 
 
@@ -329,7 +329,7 @@ class _Selection:
     def alpha(self, name: str) -> float:
         kind = effect_type(name)
         if getattr(kind, "fallback", False):
-            places = len(KNOT_COUNTS)
+            places = len(kind.knot_counts)
         elif any(p.rule == "position" for p in kind.parameters):
             places = 2 * self.n_modes + 1
         else:
@@ -341,7 +341,10 @@ class _Selection:
                                      self.alpha(fit.name))
 
     def penalised(self, fit: Fit) -> float:
-        return fit.misfit.chi2 + self.threshold(fit)
+        """Bayesian information criterion in units of the noise floor, χ²/s² + p ln n: the
+        ranking of candidates that are not nested (a crack against a section loss, which
+        fits a crack as well with two more parameters)."""
+        return fit.misfit.chi2 / self.floor + fit.n_params * np.log(fit.misfit.n_residuals)
 
     def better(self, a: Fit, b: Fit, alpha: float | None = None) -> bool:
         """a explains significantly more than b (nested or not)."""
@@ -359,7 +362,7 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
         f.threshold = sel.threshold(f)
         f.significant = (f.success and not f.failed and f.gain > f.threshold
                          and f.size_sigmas >= SIZE_SIGMAS)
-        if f.significant and material is not None and f.name != "material" \
+        if f.significant and material is not None and f.name != material.name \
                 and not material.failed:
             f.significant = sel.better(f, material)
 
@@ -395,7 +398,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         kind = effect_type(name)
         if not kind.local and any(e.name == name for e in model.effects):
             continue  # present: re-estimated in every fit
-        if any(e.name in getattr(kind, "redundant_with", ()) for e in model.effects):
+        if any(e.name in kind.redundant_with for e in model.effects):
             continue  # held by an effect present (E with a stiffness profile)
         try:
             check_enough_modes(measured, [*model.effects, Effect(name, {})])
@@ -426,7 +429,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     sel = _Selection(ref_misfit.chi2, ref_params, len(fits) + len(fallback_names),
                      measured.n_modes)
     sel.floor = _floor([*fits, reference])
-    material = next((f for f in fits if f.name == "material"), None)
+    material = next((f for f in fits if effect_type(f.name).uniform_reference), None)
     _judge(fits, sel, material, model)
 
     notes = []
@@ -455,7 +458,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             best = _best(fits, sel)
             fits.append(profile)
         if best is not None and not explains(best):
-            pair = _lookahead(model, measured, noise, best, fits, hint, explains)
+            pair = _lookahead(model, measured, noise, best, fits, hint, explains, sel)
             if pair is not None:
                 notes.append(f"{best.name} with a further {pair.name} brings the misfit to the "
                              f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}): add them one "
@@ -525,14 +528,13 @@ def _fallback(model, measured, noise, names, sel, band, progress):
     beats significantly kept; the mass profile only if the stiffness one does not fit."""
     chosen = None
     for name in names:
-        counts = KNOT_COUNTS if name == "stiffness_profile" else KNOT_COUNTS[:3]
-        counts = [k for k in counts if k <= max(2, 2 * measured.n_modes - 1)]
+        kind = effect_type(name)
+        counts = [k for k in kind.knot_counts if k <= max(2, 2 * measured.n_modes - 1)]
         jobs, labels = [], []
         for k in counts:
             x = np.linspace(0.0, model.length, k)
-            start = (_generic_ratio(band, model, x)
-                     if name == "stiffness_profile" and band is not None else None)
-            jobs.append(("profile", (model, measured, name, noise, x, start)))
+            jobs.append(("profile", (model, measured, name, noise, x,
+                                     kind.start_ratio(band, model, x))))
             labels.append(f"{name} ({k} knots)")
         profiles = [f for f in _run_jobs(jobs, progress, labels) if f.success]
         if not profiles:
@@ -548,17 +550,7 @@ def _fallback(model, measured, noise, names, sel, band, progress):
     return chosen
 
 
-def _generic_ratio(band, model, x):
-    """The generic update's nodal k_i / k_i0 (against its null profile) fitted by a
-    piecewise-linear function with knots x (least squares): the start of a stiffness
-    profile."""
-    ratio = band.ratio
-    hats = np.stack([np.interp(model.nodes, x, np.eye(len(x))[i]) for i in range(len(x))], 1)
-    values = np.linalg.lstsq(hats, ratio, rcond=None)[0]
-    return list(np.clip(values, 0.06, 2.9))
-
-
-def _lookahead(model, measured, noise, best, fits, hint, explains):
+def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
     """``best`` with one more effect: every other candidate that fitted, and a further
     instance of ``best`` when it is local.  Returns the simplest pair that ``explains`` the data (χ²
     plus the pair's parameter count as a tie-break), else None."""
@@ -570,7 +562,7 @@ def _lookahead(model, measured, noise, best, fits, hint, explains):
     jobs = [("candidate", (model, measured, name, noise, hint, None, (first,)))
             for name in seconds]
     pairs = [p for p in _run_jobs(jobs, None, seconds) if p.success and explains(p)]
-    return min(pairs, key=lambda f: (f.n_params, f.misfit.chi2), default=None)
+    return min(pairs, key=sel.penalised, default=None)
 
 
 def _generic_update(model, measured, noise):
@@ -762,13 +754,11 @@ def _profile_start(model, measured, effect, noise):
     ratios from the generic update (stiffness) or 1."""
     if "x" in effect.parameters and "ratio" in effect.parameters:
         return effect
-    band = None
-    if effect.name == "stiffness_profile" and model.kind == "beam":
-        _, band = _generic_update(model, measured, noise)
+    kind = effect_type(effect.name)
+    band = _generic_update(model, measured, noise)[1] if model.kind == "beam" else None
     if "x" in effect.parameters:
         x = effect.parameters["x"]
-        start = (_generic_ratio(band, model, np.asarray(x)) if band is not None
-                 else [1.0] * len(x))
+        start = kind.start_ratio(band, model, np.asarray(x)) or [1.0] * len(x)
         return Effect(effect.name, {"x": list(x), "ratio": list(start)})
     C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     ref = misfit(model, measured, noise, C)

@@ -179,7 +179,7 @@ def slots_for(model: Model, adding) -> list[Slot]:
         missing = [k for k in kind.fixed_keys() if k not in fixed]
         if missing:
             raise GfeInputError(None, e.name, f"needs {', '.join(missing)} to be fitted")
-        held = any(n in names for n in getattr(kind, "redundant_with", ()))
+        held = any(n in names for n in kind.redundant_with)
         variables = () if held else tuple(kind.variables(base, fixed))
         out.append(Slot(kind, fixed, dict(e.parameters), variables, added))
     return out

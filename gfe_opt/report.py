@@ -7,10 +7,8 @@ import html
 import io
 from pathlib import Path
 
-import numpy as np
-
 from . import plots
-from .elements import christides_barr_q
+from .effects import effect_type
 from .measured import atomic_write
 
 
@@ -36,13 +34,8 @@ def diagnosis_figures(diagnosis, model) -> dict:
     if band is not None:
         figs["stiffness_change.png"] = plots.profile_with_band(
             band, label=best.name if best else None)
-        if best is not None and best.name == "crack" and model.depth:
-            fine = np.linspace(0, model.length, 2000)
-            q = christides_barr_q(fine, best.parameters["position"],
-                                  best.parameters["depth_ratio"], model.depth / 2)
-            figs["disturbance.png"] = plots.disturbance_function(
-                band.x, band.ratio, fine, q,
-                label_exact=f"Q(x), fitted a/d = {best.parameters['depth_ratio']:.2f}")
+        if best is not None:
+            figs.update(effect_type(best.name).figures(model, best.parameters, band))
     if diagnosis.nodal:
         figs["nodal_equations.png"] = plots.nodal_coefficients(diagnosis.nodal)
     return figs

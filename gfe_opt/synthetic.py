@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import elements as el
-from .assembly import discretise, rigidity_function
+from .assembly import builder, discretise, rigidity_function
 from .measured import MeasuredModes, make_measured, sensor_matrix
 from .modal import discretisation_modes
 from .model import Effect, Model
@@ -23,12 +23,13 @@ def reference_discretisation(truth: Model, elements: int):
     """Fine-mesh discretisation of ``truth``; a beam's varying EI(x) (cracks, zones,
     profiles) integrated with Hermite curvatures instead of exact-flexibility elements."""
     fine = truth.with_elements(elements)
-    disc = discretise(fine)
-    rigidity, breakpoints = rigidity_function(fine)
-    if fine.kind != "beam" or not breakpoints and not fine.effects_named("stiffness_profile"):
+    build = builder(fine)
+    disc = build.discretisation()
+    if fine.kind != "beam" or not build.rigidity:
         return disc
-    if fine.effects_named("shear"):
+    if build.shear_rigidity is not None:
         raise NotImplementedError("reference with both a varying EI and shear is not provided")
+    rigidity, breakpoints = rigidity_function(fine)
     L = fine.element_length
     k = np.array([el.beam_stiffness_from_rigidity(rigidity, e * L, L, breakpoints, L / 64)
                   for e in range(elements)])

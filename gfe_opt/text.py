@@ -71,8 +71,8 @@ def format_diagnosis(result, model) -> str:
     lines = [misfit_line(result.baseline, "the model as it stands")]
     if result.reference is not None:
         lines.append(misfit_line(now, "its effects re-estimated"))
-    lines += ["", "candidates, best first (Δχ² must exceed 'needed' and the effect must lie "
-              "3 σ from nothing):",
+    lines += ["", "candidates, best first by χ²/s² + p ln n (significant: Δχ² exceeds 'needed' "
+              "and the effect lies 3 σ from nothing):",
               f"{'rank':>4}  {'effect':<18} {'χ²/n':>8} {'f err %':>8} {'MAC':>7} "
               f"{'Δχ²':>9} {'needed':>8} {'size σ':>7}  significant"]
     for i, f in enumerate(result.fits, 1):

@@ -179,6 +179,10 @@ class EffectType:
     candidate: bool = True
     #: parameters (contract) and those fitted (the others, e.g. a side, are fixed per fit)
     parameters: tuple = ()
+    #: a uniform change every other candidate must beat (a uniform change is not a crack)
+    uniform_reference: bool = False
+    #: effects whose presence holds this one (E and a stiffness profile are one parameter)
+    redundant_with: tuple = ()
 
     # -- parameters -------------------------------------------------------------------
     @property
@@ -290,6 +294,11 @@ class EffectType:
     def position(self, params: dict) -> float | None:
         """Where a local effect sits [m] (None for distributed ones)."""
         return params.get("position")
+
+    def figures(self, model, params: dict, band) -> dict:
+        """Extra figures when this effect is found (name -> matplotlib figure); ``band`` is
+        the generic update's :class:`~gfe_opt.realisation.ProfileBand` or None."""
+        return {}
 
 
 def format_value(p: Parameter, value, sigma=None) -> str:

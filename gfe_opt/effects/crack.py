@@ -51,6 +51,11 @@ class Crack(EffectType):
     def starts(self, model, hint):
         return [{}, {"position": hint * model.length, "depth_ratio": 0.45}]
 
+    def figures(self, model, params, band):
+        if band is None or model.depth is None:
+            return {}
+        return {"disturbance.png": _disturbance_figure(model, params, band)}
+
     def mark(self, ax, model, params, sigma, y):
         x = params["position"]
         ax.plot([x], [y], marker="v", color="tab:red", ms=9, zorder=5)
@@ -62,3 +67,14 @@ class Crack(EffectType):
 
 
 EFFECT = Crack()
+
+
+def _disturbance_figure(model, params, band):
+    """The paper's Fig. 5: identified Q_i = k_i / k_i0 against Christides–Barr Q(x)."""
+    from .. import plots
+
+    fine = np.linspace(0, model.length, 2000)
+    q = el.christides_barr_q(fine, params["position"], params["depth_ratio"], model.depth / 2)
+    return plots.disturbance_function(band.x, band.ratio, fine, q,
+                                      label_exact=f"Q(x), fitted a/d = "
+                                                  f"{params['depth_ratio']:.2f}")

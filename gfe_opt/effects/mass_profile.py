@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .profile import ProfileEffect
+from .profile import KNOT_COUNTS, ProfileEffect
 
 
 class MassProfile(ProfileEffect):
@@ -10,6 +10,7 @@ class MassProfile(ProfileEffect):
     physics = "ρA(x) = ρA · ratio(x), piecewise linear between the knots x"
     signature = "a distributed change of the coefficient of ẅ (ü) along the structure"
     quantity = "mass"
+    knot_counts = KNOT_COUNTS[:3]
 
 
 EFFECT = MassProfile()

@@ -14,6 +14,7 @@ class Material(EffectType):
     parameters = (Parameter("E", "Pa", "positive", "Young's modulus", null="E"),)
     #: E and a stiffness profile are one parameter: E is held when a profile is fitted
     redundant_with = ("stiffness_profile",)
+    uniform_reference = True
 
     def check(self, model, params, where, prefix):
         if "E" in params and not 1e7 <= params["E"] <= 1e13:

@@ -41,11 +41,15 @@ class ProfileEffect(EffectType):
         scale = build.scale_rigidity if self.quantity == "rigidity" else build.scale_mass
         scale(f, breakpoints=tuple(params["x"][1:-1]))
 
+    #: knot counts diagnose tries, coarse to fine (each set contains the previous one)
+    knot_counts = KNOT_COUNTS
+
     def variables(self, model, fixed):
         return [Variable("ratio", 0.05, 3.0, (1.0,), index=i) for i in range(len(fixed["x"]))]
 
-    def fixed_keys(self):
-        return ("x",)
+    def start_ratio(self, band, model, x):
+        """Starting ratios at knots x (None: 1 everywhere)."""
+        return None
 
     def starts(self, model, hint):
         return [{"x": list(np.linspace(0.0, model.length, k))} for k in KNOT_COUNTS]
