@@ -134,6 +134,12 @@ class Variable:
         return float(value / s)
 
 
+def position_variable() -> Variable:
+    """x / length in [0, 1], grid of 19 places: the position of a local effect."""
+    return Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
+                    scale=lambda model: model.length)
+
+
 def as_float(value, where, field) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise GfeInputError(where, field, f"must be a number, got {value!r}")

@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import elements as el
 from ..errors import GfeInputError
-from .base import EffectType, Parameter, Variable
+from .base import EffectType, Parameter, Variable, position_variable
 
 #: Q(x) differs from 1 by less than 26 e^-36 (~1e-14) beyond 18 decay lengths
 CRACK_REACH = 18.0
@@ -44,8 +44,7 @@ class Crack(EffectType):
                              support=(x_c - CRACK_REACH * decay, x_c + CRACK_REACH * decay))
 
     def variables(self, model, fixed):
-        return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
-                         scale=lambda m: m.length),
+        return [position_variable(),
                 Variable("depth_ratio", 0.01, 0.9, (0.2, 0.45, 0.7))]
 
     def starts(self, model, hint):

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import numpy as np
-
-from .base import EffectType, Parameter, Variable
+from .base import EffectType, Parameter, Variable, position_variable
 
 
 class PointMass(EffectType):
@@ -22,8 +20,7 @@ class PointMass(EffectType):
         build.add_point_mass(params["position"], params["mass"])
 
     def variables(self, model, fixed):
-        return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
-                         scale=lambda m: m.length),
+        return [position_variable(),
                 Variable("mass", 1e-4, 3.0, (0.05, 0.2, 0.5),
                          scale=lambda m: m.rho * m.area * m.length)]
 

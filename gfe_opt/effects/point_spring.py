@@ -3,9 +3,7 @@ attachment)."""
 
 from __future__ import annotations
 
-import numpy as np
-
-from .base import EffectType, Parameter, Variable, nominal_rigidity
+from .base import EffectType, Parameter, Variable, nominal_rigidity, position_variable
 
 
 def _scale(model):
@@ -29,8 +27,7 @@ class PointSpring(EffectType):
         build.add_point_stiffness(params["position"], params["stiffness"])
 
     def variables(self, model, fixed):
-        return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
-                         scale=lambda m: m.length),
+        return [position_variable(),
                 Variable("stiffness", -3.0, 5.0, (0.0, 1.0, 2.0), log=True, scale=_scale)]
 
     def starts(self, model, hint):

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import GfeInputError
-from .base import EffectType, Parameter, Variable
+from .base import EffectType, Parameter, Variable, position_variable
 
 
 def zone(centre: float, length: float, ratio: float):
@@ -47,8 +47,7 @@ class SectionLoss(EffectType):
         build.scale_mass(zone(c, ell, params["mass_ratio"]), breakpoints=edges, support=edges)
 
     def variables(self, model, fixed):
-        return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
-                         scale=lambda m: m.length),
+        return [position_variable(),
                 Variable("length", 0.004, 0.3, (0.05,), scale=lambda m: m.length),
                 Variable("stiffness_ratio", 0.05, 3.0, (0.7,)),
                 Variable("mass_ratio", 0.05, 3.0, (1.0,))]
