@@ -127,16 +127,77 @@ def expand_modes(disc: Discretisation, C, omega, shapes, noise: float = DEFAULT_
                 lu = spla.splu(D)
             except RuntimeError:  # ω is exactly a model eigenvalue: nudge it
                 lu = spla.splu((Kf - (w * (1 + 1e-9)) ** 2 * Mf).tocsc())
-            X = lu.solve(Cf.T.toarray())  # D^-1 C^T, (n_free, n_sensors)
-            G = Cf @ X
-            G = 0.5 * (G + G.T)
-            lam = _tikhonov_discrepancy(G, y, noise)
-            phi = X @ lam
+            if Cf.shape[0] <= DENSE_SENSOR_LIMIT:
+                X = lu.solve(Cf.T.toarray())  # D^-1 C^T, (n_free, n_sensors)
+                G = Cf @ X
+                G = 0.5 * (G + G.T)
+                lam = _tikhonov_discrepancy(G, y, noise)
+                phi = X @ lam
+            else:  # many sensors: the same solution from a sparse system, memory O(n)
+                phi, lam = _tikhonov_sparse(D, Cf, y, noise)
         out_shapes[free, j] = phi
         inertia = np.linalg.norm(w**2 * (Mf @ phi))
         forces[:, j] = lam
         rel[:, j] = np.abs(lam) / inertia if inertia > 0 else np.inf
     return Expansion(out_shapes, forces, rel)
+
+
+#: above this many sensors the expansion avoids dense sensor x sensor and DOF x sensor
+#: matrices (a sensor at every node of a fine mesh)
+DENSE_SENSOR_LIMIT = 200
+
+
+def _tikhonov_sparse(D, C, y, noise):
+    r"""The Tikhonov expansion of :func:`_tikhonov_discrepancy` without forming
+    :math:`G = C D^{-1} C^T`: for each α the sparse symmetric system
+
+    .. math:: \begin{bmatrix} C^TC & 0 & D \\ 0 & α^2 I & -C \\ D & -C^T & 0
+              \end{bmatrix} \begin{bmatrix} φ \\ λ \\ μ \end{bmatrix} =
+              \begin{bmatrix} C^T y \\ 0 \\ 0 \end{bmatrix}
+
+    (stationarity of ‖Cφ − y‖² + α²‖λ‖² subject to Dφ = Cᵀλ), α by bisection on log α to
+    the discrepancy ‖Cφ − y‖ = δ max|y| √n_s.  Returns (φ, λ)."""
+    n, s = D.shape[0], C.shape[0]
+    target = noise * np.max(np.abs(y)) * np.sqrt(s)
+    scale = np.sqrt(np.abs(D.diagonal()).max())  # D / scale² is O(1) next to CᵀC
+    # rows scaled by 1/scale, μ carried as scale·μ: the same solution, better pivots
+    base = sp.bmat([[(C.T @ C).tocsc(), None, D / scale],
+                    [None, sp.csc_matrix((s, s)), -C / scale],
+                    [D / scale, -C.T / scale, None]]).tocsc()
+    lam_rows = sp.diags(np.concatenate([np.zeros(n), np.ones(s), np.zeros(n)])).tocsc()
+    rhs = np.concatenate([C.T @ y, np.zeros(s + n)])
+
+    def solve(log_alpha):
+        sol = spla.splu((base + np.exp(2 * log_alpha) * lam_rows).tocsc()).solve(rhs)
+        phi, lam = sol[:n], sol[n:n + s]
+        return phi, lam, np.log(np.linalg.norm(C @ phi - y)) - np.log(target)
+
+    # α has the units of the receptance G = C D⁻¹ Cᵀ: bracket it about an estimate of ‖G‖;
+    # the misfit grows with α: regula falsi (Illinois) on log α, to 1e-4 in the misfit
+    probe = np.ones(s) / np.sqrt(s)
+    g_norm = np.linalg.norm(C @ spla.splu(D).solve(C.T @ probe))
+    a, b = np.log(1e-9 * g_norm), np.log(1e3 * g_norm)
+    phi, lam, fa = solve(a)
+    if fa >= 0:
+        return phi, lam
+    phi, lam, fb = solve(b)
+    if fb <= 0:
+        return phi, lam
+    side = 0
+    for _ in range(60):
+        c = b - fb * (b - a) / (fb - fa)
+        phi, lam, fc = solve(c)
+        if abs(fc) < 1e-4:
+            break
+        if fc < 0:
+            a, fa = c, fc
+            fb = fb / 2 if side == -1 else fb
+            side = -1
+        else:
+            b, fb = c, fc
+            fa = fa / 2 if side == 1 else fa
+            side = 1
+    return phi, lam
 
 
 def _tikhonov_discrepancy(G, y, noise):

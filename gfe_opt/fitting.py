@@ -19,8 +19,9 @@ Every instance of an effect in the model is a *slot*: its fitted parameters are 
 variables (:class:`~gfe_opt.effects.Variable`, with bounds), its chosen ones (a spring's
 side, a profile's knots) are fixed.  Instances already in the model start where they are;
 added ones start from given values or from the best point of a coarse grid.  χ² is
-minimised by IPOPT through CasADi with a forward-difference Jacobian of the residual vector
-and the Gauss–Newton Hessian.
+minimised by IPOPT through CasADi: the objective ½‖r‖², its gradient Jᵀr and the
+Gauss–Newton Hessian JᵀJ come from one forward-difference Jacobian J per point (small
+callbacks: IPOPT sees n × n matrices, however many residuals there are).
 
 Uncertainty
 -----------
@@ -320,10 +321,10 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     z = z_start
     if n:
         chi2_start = chi2(z_start)
-        scale = np.sqrt(max(chi2_start, 1.0))  # objective starts at 1/2: relative tolerances
-        r_fun = _Residual(lambda zz: residual(zz) / scale, n, n_res)
+        scale = max(chi2_start, 1.0)  # objective starts at 1/2: relative tolerances
+        objective = _GaussNewton(lambda zz: residual(zz) / np.sqrt(scale), n)
         x = ca.MX.sym("z", n)
-        solver = ca.nlpsol("effects", "ipopt", {"x": x, "f": 0.5 * ca.sumsqr(r_fun(x))},
+        solver = ca.nlpsol("effects", "ipopt", {"x": x, "f": objective(x)},
                            {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
                             "ipopt.max_iter": max_iter, "ipopt.tol": 1e-3,
                             # measured: the adaptive barrier halves the evaluations
@@ -444,14 +445,29 @@ def _grid_start(chi2, grids):
 # -------------------------------------------------------------------------------------------
 
 
-class _Residual(ca.Callback):
-    """r(z) as a CasADi function with a forward-difference Jacobian whose own derivative is
-    zero, so IPOPT's exact-Hessian mode on ½‖r‖² performs Gauss–Newton steps."""
+class _GaussNewton(ca.Callback):
+    """½‖r(z)‖² as a CasADi function of z with its gradient Jᵀr and the Gauss–Newton
+    Hessian JᵀJ, J the forward-difference Jacobian of r, computed once per point and shared:
+    IPOPT sees only n × n matrices, however many residuals there are."""
 
-    def __init__(self, fun, n: int, m: int, step: float = 1e-6):
+    def __init__(self, fun, n: int, step: float = 1e-6):
         ca.Callback.__init__(self)
-        self.fun, self.n, self.m, self.step = fun, n, m, step
-        self.construct("residual", {})
+        self.fun, self.n, self.step = fun, n, step
+        self._point = None
+        self.construct("half_sum_of_squares", {})
+
+    def residual_and_jacobian(self, z):
+        key = z.tobytes()
+        if self._point is None or self._point[0] != key:
+            r0 = self.fun(z)
+            jac = np.zeros((r0.size, self.n))
+            for k in range(self.n):
+                dz = z.copy()
+                h = self.step * max(1.0, abs(z[k]))
+                dz[k] += h
+                jac[:, k] = (self.fun(dz) - r0) / h
+            self._point = (key, r0, jac)
+        return self._point[1], self._point[2]
 
     def get_n_in(self):
         return 1
@@ -463,21 +479,24 @@ class _Residual(ca.Callback):
         return ca.Sparsity.dense(self.n, 1)
 
     def get_sparsity_out(self, i):
-        return ca.Sparsity.dense(self.m, 1)
+        return ca.Sparsity.dense(1, 1)
 
     def eval(self, arg):
-        return [self.fun(np.array(arg[0]).ravel())]
+        r = self.fun(np.array(arg[0]).ravel())
+        return [0.5 * float(r @ r)]
 
     def has_jacobian(self):
         return True
 
     def get_jacobian(self, name, inames, onames, opts):
-        self._jacobian = _ForwardDifference(name, self)
-        return self._jacobian
+        self._gradient = _Gradient(name, self)
+        return self._gradient
 
 
-class _ForwardDifference(ca.Callback):
-    def __init__(self, name, outer: _Residual):
+class _Gradient(ca.Callback):
+    """d(½‖r‖²)/dz = (Jᵀr)ᵀ; its own Jacobian is the Gauss–Newton Hessian."""
+
+    def __init__(self, name, outer: _GaussNewton):
         ca.Callback.__init__(self)
         self.outer = outer
         self.construct(name, {})
@@ -489,39 +508,30 @@ class _ForwardDifference(ca.Callback):
         return 1
 
     def get_sparsity_in(self, i):
-        return ca.Sparsity.dense(self.outer.n if i == 0 else self.outer.m, 1)
+        return ca.Sparsity.dense(self.outer.n, 1) if i == 0 else ca.Sparsity.dense(1, 1)
 
     def get_sparsity_out(self, i):
-        return ca.Sparsity.dense(self.outer.m, self.outer.n)
+        return ca.Sparsity.dense(1, self.outer.n)
 
     def eval(self, arg):
-        z, r0 = np.array(arg[0]).ravel(), np.array(arg[1]).ravel()
-        key = z.tobytes()
-        if getattr(self, "_cached", (None,))[0] == key:  # gradient and Hessian: one point
-            return [self._cached[1]]
-        jac = np.zeros((self.outer.m, self.outer.n))
-        for k in range(self.outer.n):
-            dz = z.copy()
-            h = self.outer.step * max(1.0, abs(z[k]))
-            dz[k] += h
-            jac[:, k] = (self.outer.fun(dz) - r0) / h
-        self._cached = (key, jac)
-        return [jac]
+        r, jac = self.outer.residual_and_jacobian(np.array(arg[0]).ravel())
+        return [(jac.T @ r)[None, :]]
 
     def has_jacobian(self):
         return True
 
     def get_jacobian(self, name, inames, onames, opts):
-        self._zero = _Zero(name, self.outer.n, self.outer.m)
-        return self._zero
+        self._hessian = _Hessian(name, self.outer)
+        return self._hessian
 
 
-class _Zero(ca.Callback):
-    """The (neglected) second derivative of the residual: Gauss–Newton."""
+class _Hessian(ca.Callback):
+    """JᵀJ (the second derivative of r neglected) and a zero derivative with respect to
+    the objective value."""
 
-    def __init__(self, name, n, m):
+    def __init__(self, name, outer: _GaussNewton):
         ca.Callback.__init__(self)
-        self.n, self.m = n, m
+        self.outer = outer
         self.construct(name, {})
 
     def get_n_in(self):
@@ -531,12 +541,13 @@ class _Zero(ca.Callback):
         return 2
 
     def get_sparsity_in(self, i):
-        return [ca.Sparsity.dense(self.n, 1), ca.Sparsity.dense(self.m, 1),
-                ca.Sparsity.dense(self.m, self.n)][i]
+        n = self.outer.n
+        return [ca.Sparsity.dense(n, 1), ca.Sparsity.dense(1, 1), ca.Sparsity.dense(1, n)][i]
 
     def get_sparsity_out(self, i):
-        return ca.Sparsity(self.m * self.n, self.n if i == 0 else self.m)
+        return ca.Sparsity.dense(self.outer.n, self.outer.n) if i == 0 else \
+            ca.Sparsity.dense(self.outer.n, 1)
 
     def eval(self, arg):
-        return [ca.DM(ca.Sparsity(self.m * self.n, self.n)),
-                ca.DM(ca.Sparsity(self.m * self.n, self.m))]
+        _, jac = self.outer.residual_and_jacobian(np.array(arg[0]).ravel())
+        return [jac.T @ jac, np.zeros((self.outer.n, 1))]
