@@ -18,8 +18,9 @@ from .effects import EFFECTS
 from .errors import GfeInputError, GfeSolverError
 from .fitting import DEFAULT_FREQ_NOISE
 from .fitting import DEFAULT_SHAPE_NOISE as DEFAULT_FIT_SHAPE_NOISE
-from .measured import check_output_path, load_measured
+from .measured import load_measured
 from .model import load_model
+from .outputs import check_distinct, check_output_folder, check_output_path
 from .text import format_comparison, format_diagnosis, format_update, terminal_progress
 
 
@@ -122,13 +123,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _check_outputs(args, names) -> None:
-    """Refuse, before any work, outputs that would overwrite inputs or existing files."""
+    """Refuse, before any work, outputs that would overwrite inputs or existing files, that
+    are not ordinary files, or that share a path (gfe_opt.outputs)."""
     inputs = [a for a in (getattr(args, "model", None), getattr(args, "measured", None)) if a]
-    if getattr(args, "plot", None):
+    paths = {"--out": getattr(args, "out", None), "--report": getattr(args, "report", None)}
+    if getattr(args, "plot", None) is not None:
+        folder = check_output_folder(args.plot)
         for name in names:
-            check_output_path(Path(args.plot) / name, args.force, inputs)
-    if getattr(args, "report", None):
-        check_output_path(args.report, args.force, inputs)
+            check_output_path(folder / name, args.force, inputs, kind="figure",
+                              where="--plot")
+            paths[f"--plot {name}"] = folder / name
+    if getattr(args, "report", None) is not None:
+        check_output_path(args.report, args.force, inputs, kind="report", where="--report")
+    check_distinct(paths)
 
 
 def _write_outputs(args, figs, fill_report, title) -> None:
@@ -199,21 +206,32 @@ def cmd_compare(args) -> int:
 
 
 def cmd_modes(args) -> int:
+    from .assembly import discretise
     from .measured import make_measured, save_measured
-    from .modal import model_modes
+    from .modal import discretisation_modes, rigid_body_count
 
-    check_output_path(args.out, args.force, (args.model,))
+    check_output_path(args.out, args.force, (args.model,), kind="modes")
     model = load_model(args.model)
     if args.modes < 1:
         raise GfeInputError("--modes", None, f"must be >= 1, got {args.modes}")
-    modes = model_modes(model, args.modes)
+    disc = discretise(model)
+    rigid = rigid_body_count(disc)
+    if args.modes + rigid > len(disc.free) - 1:
+        raise GfeInputError("--modes", None, f"the model has {len(disc.free) - 1 - rigid} "
+                            f"elastic modes at most, asked for {args.modes}")
+    modes = discretisation_modes(disc, args.modes + rigid)
+    elastic = modes.frequencies_hz > 0  # measured modes vibrate: rigid-body ones left out
     per = model.dofs_per_node
-    shapes = modes.shapes[::per]  # translations at the nodes
+    shapes = modes.shapes[::per][:, elastic]  # translations at the nodes
     keep = np.any(shapes != 0, axis=1)
     save_measured(make_measured(model.nodes[keep], "w" if model.kind == "beam" else "u",
-                                modes.frequencies_hz, shapes[keep], model.name), args.out)
-    print(f"{args.modes} modes of {model.name} at {int(keep.sum())} nodes written to "
+                                modes.frequencies_hz[elastic], shapes[keep], model.name),
+                  args.out, force=args.force, protect=(args.model,))
+    print(f"{int(elastic.sum())} modes of {model.name} at {int(keep.sum())} nodes written to "
           f"{args.out}")
+    if rigid:
+        print(f"note: {rigid} rigid-body mode{'s' if rigid > 1 else ''} (0 Hz) left out: a "
+              "test measures vibration")
     return 0
 
 
@@ -258,12 +276,12 @@ def cmd_update(args) -> int:
     model = load_model(args.model)
     measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
     effects = [parse_effect(a, model) for a in args.add]
-    if args.out:  # refuse before the work, not after
-        check_output_path(args.out, args.force, (args.model, args.measured))
+    if args.out is not None:  # refuse before the work, not after
+        check_output_path(args.out, args.force, (args.model, args.measured), kind="model")
     _check_outputs(args, ("error.png",))
     outcome = update(model, measured, effects, freq_noise=args.freq_noise,
                      shape_noise=args.shape_noise)
-    if args.out:
+    if args.out is not None:
         save_model(outcome.model, args.out, force=args.force,
                    protect=(args.model, args.measured))
     if args.json:

@@ -34,7 +34,7 @@ from scipy.optimize import linear_sum_assignment
 from .assembly import Discretisation, discretise
 from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, sensor_matrix
-from .modal import Modes, discretisation_modes
+from .modal import Modes, discretisation_modes, rigid_body_count
 from .model import Model
 
 DEFAULT_MAC_THRESHOLD = 0.6
@@ -223,6 +223,20 @@ def _tikhonov_discrepancy(G, y, noise):
     return vt.T @ (s / (s**2 + alpha**2) * beta)
 
 
+def check_model_size(disc: Discretisation, measured: MeasuredModes, where: str = "model"
+                     ) -> None:
+    """The model needs more elastic modes than the test measured (one to spare for
+    pairing); a mesh too coarse for the test is one line, not a solver failure."""
+    available = len(disc.free) - 1 - rigid_body_count(disc)
+    if available < measured.n_modes + 1:
+        per_mode = 4
+        modes = f"{max(available, 0)} elastic mode{'' if available == 1 else 's'}"
+        raise GfeInputError(where, "elements", f"{disc.n_elements} elements give the model "
+                            f"{modes}, too few for the {measured.n_modes} measured: use at least "
+                            f"{per_mode * (measured.n_modes + 1)} elements ({per_mode} per "
+                            "mode)")
+
+
 def check_frequency_units(measured: MeasuredModes, model_hz) -> None:
     """Reject measured frequencies that differ from the model's by a factor that points to
     wrong units (rad/s for Hz, kHz, a model in millimetres): the measured first frequency
@@ -307,16 +321,20 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
     ``noise`` is the relative shape noise δ used to regularise the expansion.
     """
     disc = discretise(model) if disc is None else disc
+    check_model_size(disc, measured, model.source or model.name)
     C = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
     n_free = len(disc.free)
-    n_model = n_model_modes or min(max(2 * measured.n_modes, measured.n_modes + 4), n_free - 2)
+    rigid = rigid_body_count(disc)
+    n_model = n_model_modes or min(max(2 * measured.n_modes, measured.n_modes + 4) + rigid,
+                                   n_free - 2)
     K, M = disc.global_matrices()
     modes = discretisation_modes(disc, n_model, matrices=(K, M))
     check_frequency_units(measured, modes.frequencies_hz)
     at_sensors = C @ modes.shapes
     mac_matrix = mac(measured.shapes, at_sensors)
-    pairs_idx = pair_modes(mac_matrix, mac_threshold, measured.frequencies_hz,
-                           modes.frequencies_hz)
+    # measured modes vibrate (f > 0): a rigid-body model mode is never their partner
+    pairs_idx = pair_modes(np.where(modes.frequencies_hz > 0, mac_matrix, 0.0), mac_threshold,
+                           measured.frequencies_hz, modes.frequencies_hz)
     pairs = [Pair(test_mode=t + 1, model_mode=m + 1,
                   test_hz=float(measured.frequencies_hz[t]),
                   model_hz=float(modes.frequencies_hz[m]),

@@ -51,7 +51,7 @@ def run_demo(out: Path, force: bool = False) -> int:
     sensors = interior_sensors(model.length, 45)
     measured = synthetic_measurement(truth, 5, sensors, shape_noise=0.003, freq_noise=0.0005,
                                      seed=2002)
-    save_measured(measured, measured_path)
+    save_measured(measured, measured_path, force=True)
     print(f"2. The test ({measured_path}): 5 modes at 45 accelerometers, simulated with an "
           "independent fine model\n   of the real beam, which has something the model lacks "
           "(0.3 % shape noise, 0.05 % frequency noise).")

@@ -60,7 +60,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import chdtri
 
-from .correlation import compare
+from .correlation import check_model_size, compare
 from .effects import candidate_names, effect_type
 from .errors import GfeInputError, GfeSolverError
 from .fitting import (
@@ -383,6 +383,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     start = time.perf_counter()
     noise = noise_of(freq_noise, shape_noise)
     names = _candidates(model, candidates)
+    check_model_size(_discretise(model), measured, model.source or model.name)
     C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     baseline = misfit(model, measured, noise, C)
     places = compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
@@ -702,6 +703,7 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     from the diagnosis of that effect alone.  A global effect already in the model, or
     added twice, is an error."""
     noise = noise_of(freq_noise, shape_noise)
+    check_model_size(_discretise(model), measured, model.source or model.name)
     effects = [parse_effect(a, model) if isinstance(a, str) else a for a in add]
     for e in effects:
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",

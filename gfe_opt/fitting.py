@@ -39,11 +39,12 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from .assembly import discretise
 from .correlation import mac, pair_modes
 from .effects import EffectType, effect_type
 from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, sensor_matrix
-from .modal import model_modes
+from .modal import discretisation_modes, rigid_body_count
 from .model import Effect, Model
 
 DEFAULT_FREQ_NOISE = 0.0005
@@ -119,17 +120,18 @@ def misfit(model: Model, measured: MeasuredModes, noise: Noise, C=None) -> Misfi
 def residuals(model, measured, noise: Noise, C=None):
     """Fixed-length residual vector (per measured mode: frequency, then sensors), the
     relative frequency errors and MACs of the pairs; ``(None, ...)`` if the solve fails."""
-    n_model = min(measured.n_modes + 4, _max_modes(model))
     try:
-        modes = model_modes(model, n_model)
+        disc = discretise(model)
+        n_model = min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(model))
+        modes = discretisation_modes(disc, n_model)
     except (GfeSolverError, ValueError, np.linalg.LinAlgError):
         return None, np.zeros(0), np.zeros(0)
     if C is None:
         C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     shapes = C @ modes.shapes
     mac_matrix = mac(measured.shapes, shapes)
-    pairs = pair_modes(np.nan_to_num(mac_matrix), 0.3, measured.frequencies_hz,
-                       modes.frequencies_hz)
+    elastic = np.where(modes.frequencies_hz > 0, np.nan_to_num(mac_matrix), 0.0)
+    pairs = pair_modes(elastic, 0.3, measured.frequencies_hz, modes.frequencies_hz)
     rows = np.array([t for t, _ in pairs], dtype=int)
     cols = np.array([m for _, m in pairs], dtype=int)
     r = np.zeros((measured.n_modes, 1 + measured.n_sensors))

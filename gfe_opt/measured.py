@@ -14,14 +14,15 @@ Formats (contracts, see README "Measured modes"):
   one dataset 55 (analysis type 2, normal modes) per mode.  ``w`` is read from the z
   component (or y when every z is zero), ``u`` from the x component.
 
-Shapes may have any scale and sign.  Modes are sorted by frequency; sensors keep file order.
+Shapes may have any scale and sign; they are kept with each mode's largest amplitude at 1 (a
+mode shape's scale means nothing, and 1e300 squared overflows).  Modes are sorted by
+frequency; sensors keep file order.
 """
 
 from __future__ import annotations
 
 import csv
 import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,6 +31,7 @@ import scipy.sparse as sp
 
 from . import elements as el
 from .errors import GfeInputError
+from .outputs import atomic_write, check_output_path
 
 DOFS = ("w", "u")
 
@@ -84,6 +86,9 @@ def make_measured(x, dof, frequencies_hz, shapes, source="measured") -> Measured
     zero = np.flatnonzero(~np.any(shapes != 0, axis=0))
     if zero.size:
         raise GfeInputError(source, f"modes[{zero[0]}].shape", "all values are zero")
+    # shapes have any scale: each mode to a largest amplitude of 1 before any product
+    # (1e300 squared overflows, 1e-320 squared underflows)
+    shapes = shapes / np.max(np.abs(shapes), axis=0)
     order = np.argsort(f, kind="stable")
     f, shapes = f[order], shapes[:, order]
     dup = np.flatnonzero(np.diff(f) == 0)
@@ -206,10 +211,30 @@ def _read_csv(path: Path, dof: str) -> MeasuredModes:
     return make_measured(x, dof, freqs, np.array(shapes), where)
 
 
+def _check_uff_complete(path: Path) -> None:
+    """Every ASCII dataset of a universal file opens and closes with a line ``    -1``: an
+    odd count means the file ends inside a dataset (cut short), which pyuff would drop
+    without a word."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(80)
+            if b"\0" in head:
+                return  # binary universal file: pyuff checks its record lengths
+            fh.seek(0)
+            delimiters = sum(1 for line in fh if line.strip() == b"-1")
+    except OSError as exc:
+        raise GfeInputError(str(path), None, f"cannot read ({exc.strerror})") from None
+    if delimiters % 2:
+        raise GfeInputError(str(path), None, f"incomplete: the file ends inside a dataset "
+                            f"({delimiters} '-1' delimiter lines, an even number expected); "
+                            "was it cut short?")
+
+
 def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
     import pyuff
 
     where = str(path)
+    _check_uff_complete(path)
     try:
         sets = pyuff.UFF(str(path)).read_sets()
     except Exception as exc:  # pyuff raises bare Exceptions on malformed files
@@ -251,29 +276,6 @@ def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
 # -------------------------------------------------------------------------------------------
 
 
-def atomic_write(path, write) -> None:
-    """Call ``write(tmp_path)`` and move the result onto ``path`` in one step."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-
-
-def check_output_path(out, force: bool, inputs=()) -> None:
-    """Refuse an output path that is one of ``inputs``, or that exists without ``force``."""
-    out = Path(out)
-    for p in inputs:
-        if Path(p).resolve() == out.resolve():
-            raise GfeInputError(str(out), None, "would overwrite an input file; choose "
-                                "another output path")
-    if out.exists() and not force:
-        raise GfeInputError(str(out), None, "exists already; pass --force to overwrite it")
-
-
 def measured_to_dict(m: MeasuredModes) -> dict:
     """The JSON form of measured modes."""
     return {"sensors": {"x": [float(v) for v in m.x], "dof": m.dof},
@@ -281,9 +283,10 @@ def measured_to_dict(m: MeasuredModes) -> dict:
                       for j, f in enumerate(m.frequencies_hz)]}
 
 
-def save_measured(m: MeasuredModes, path) -> None:
-    """Write measured modes as ``.json``, ``.csv`` or ``.uff``/``.unv`` (by extension)."""
-    path = Path(path)
+def save_measured(m: MeasuredModes, path, *, force: bool = False, protect=()) -> None:
+    """Write measured modes as ``.json``, ``.csv`` or ``.uff``/``.unv`` (by extension),
+    atomically, to an ordinary file (:func:`~gfe_opt.outputs.check_output_path`)."""
+    path = check_output_path(path, force, protect, kind="modes")
     suffix = path.suffix.lower()
     if suffix == ".json":
         text = json.dumps(measured_to_dict(m), indent=1)

@@ -306,6 +306,36 @@ def _reduced_element_stiffness(disc, U, params, L):
     return out + np.swapaxes(U, 1, 2) @ disc.extra_stiffness @ U
 
 
+def rigid_body_count(disc: Discretisation) -> int:
+    """How many rigid-body modes (ω = 0) the supports and springs leave: the motions
+    w = a + b x, θ = b (bar: u = a) that vanish at the constrained DOFs and store no strain
+    energy (a foundation or a spring to ground takes them away)."""
+    x = disc.nodes
+    if disc.kind == "beam":
+        basis = np.zeros((disc.n_dof, 2))
+        basis[0::2, 0] = 1.0
+        basis[0::2, 1], basis[1::2, 1] = x - x[0], 1.0
+    else:
+        basis = np.ones((disc.n_dof, 1))
+    fixed = basis[disc.constrained]
+    null = sla.null_space(fixed) if fixed.size else np.eye(basis.shape[1])
+    if null.shape[1] == 0:
+        return 0
+    motions = basis @ null
+    k = motions.shape[1]
+    # a rigid motion of the elements stores no strain energy (up to rounding): what the
+    # foundation and springs store decides; combinations count (a free beam on one spring
+    # still turns about it), so the k x k energy matrix by polarisation
+    pairs = np.stack([motions[:, i] + motions[:, j] for i in range(k) for j in range(k)], 1)
+    energy = disc.strain_energy(np.hstack([motions, pairs]))
+    single, both = energy[:k], energy[k:].reshape(k, k)
+    E = 0.5 * (both - single[:, None] - single[None, :])
+    u = motions[disc.element_dofs()]
+    Mr = np.einsum("eim,eij,ejn->mn", u, disc.mass, u)
+    lam = sla.eigh(0.5 * (E + E.T), Mr, eigvals_only=True)
+    return int(np.sum(lam <= 1e-9 * disc.eigenvalue_scale))
+
+
 def model_modes(model: Model, n_modes: int) -> Modes:
     """The lowest ``n_modes`` modes of a model (all its effects included)."""
     return discretisation_modes(discretise(model), n_modes)

@@ -328,8 +328,8 @@ def save_model(model: Model, path, *, force: bool = False, protect=()) -> None:
     (e.g. the input) and, unless ``force``, any existing file."""
     import tomli_w
 
-    from .measured import atomic_write, check_output_path
+    from .outputs import atomic_write, check_output_path
 
-    check_output_path(path, force, protect)
+    check_output_path(path, force, protect, kind="model")
     text = tomli_w.dumps(model_to_dict(model))
     atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"))

@@ -20,10 +20,11 @@ def _figure(width=7.0, height=3.6):
 
 
 def save(fig, path) -> Path:
-    """Write ``fig`` as a PNG (150 dpi) and return the path."""
+    """Write ``fig`` as a PNG (150 dpi), atomically, and return the path."""
+    from .outputs import atomic_write
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=150)
+    atomic_write(path, lambda p: fig.savefig(p, dpi=150, format="png"))
     return path
 
 

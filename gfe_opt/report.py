@@ -9,7 +9,7 @@ from pathlib import Path
 
 from . import plots
 from .effects import effect_type
-from .measured import atomic_write
+from .outputs import atomic_write
 
 
 def compare_figures(result, model) -> dict:

@@ -22,7 +22,12 @@ the regularisation holds it at its initial value).
    46-element demo beam with 5 modes, every candidate effect: wall time of the first diagnosis
    and of the check after the crack is added (best and all of 3 runs).
 
-``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose.
+6. Cost with N (issue: within 10x the 46-element cost at 2000 elements, memory linear in N
+   with a sensor at every node): `diagnose` and `update --add crack` on 46 and 2000 elements
+   with 45 sensors, and `update --add crack` with a sensor at every node on 1000 and 2000
+   elements, each in a fresh process (wall time, peak resident memory).
+
+``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale.
 """
 
 import argparse
@@ -89,7 +94,7 @@ def _in_process(n, weighting="rows"):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-elements", type=int, default=10000)
-    parser.add_argument("--parts", default="update,ratio,solvers,accuracy,diagnose")
+    parser.add_argument("--parts", default="update,ratio,solvers,accuracy,diagnose,scale")
     args = parser.parse_args()
     parts = set(args.parts.split(","))
     out = {}
@@ -107,6 +112,8 @@ def main():
         _accuracy(out, rows, sizes)
     if "diagnose" in parts:
         _diagnose(out)
+    if "scale" in parts:
+        _scale(out)
     print(json.dumps(out, indent=1))
 
 
@@ -200,6 +207,45 @@ def _diagnose(out):
         result[label] = {"best_s": min(runs), "runs_s": runs, "verdict": d.verdict,
                          "candidates": len(d.fits) + len(d.failed)}
     out["diagnose_46_elements"] = {**result, "target": "first < 3 s"}
+
+
+def _scale_run(n, sensors, what, queue):
+    from gfe_opt.diagnosis import diagnose, update
+    from gfe_opt.model import Effect, load_model
+    from gfe_opt.problems import problem_file
+    from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+
+    model = load_model(problem_file("ss-steel-beam.toml")).with_elements(n)
+    truth = model.with_effects([Effect("crack", {"position": 0.19, "depth_ratio": 0.5})])
+    x = model.nodes[1:-1] if sensors == "every node" else interior_sensors(model.length, 45)
+    measured = synthetic_measurement(truth, 5, x, shape_noise=0.003, freq_noise=0.0005,
+                                     seed=2002, reference_elements=max(400, 2 * n))
+    noise = {"freq_noise": 0.0005, "shape_noise": 0.003}
+    start = time.perf_counter()
+    if what == "diagnose":
+        result = diagnose(model, measured, realise=True, **noise).verdict
+    else:
+        result = update(model, measured, ["crack"], **noise).fit.describe()
+    queue.put({"elements": n, "sensors": sensors, "command": what,
+               "seconds": time.perf_counter() - start, "result": result,
+               "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024})
+
+
+def _scale(out):
+    ctx = mp.get_context("spawn")
+    rows = []
+    for n, sensors, what in ((46, "45", "diagnose"), (2000, "45", "diagnose"),
+                             (46, "45", "update"), (2000, "45", "update"),
+                             (1000, "every node", "update"), (2000, "every node", "update")):
+        queue = ctx.Queue()
+        proc = ctx.Process(target=_scale_run, args=(n, sensors, what, queue))
+        proc.start()
+        rows.append(queue.get())
+        proc.join()
+    by = {(r["elements"], r["sensors"], r["command"]): r for r in rows}
+    ratio = {what: by[(2000, "45", what)]["seconds"] / by[(46, "45", what)]["seconds"]
+             for what in ("diagnose", "update")}
+    out["scale"] = {"rows": rows, "ratio_2000_over_46": ratio, "target": "<= 10"}
 
 
 if __name__ == "__main__":

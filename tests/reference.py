@@ -177,3 +177,56 @@ def timoshenko_ss(n_modes, EI, rho_a, rho_i, kga, length):
 
 def interior(length, count):
     return np.linspace(0.0, length, count + 2)[1:-1]
+
+
+@dataclass
+class ReferenceBar:
+    """An axial bar of linear elements with consistent mass on a fine mesh; ``rigidity`` and
+    ``mass`` multiply EA and ρA; point masses and axial springs at positions."""
+
+    length: float = 2.0
+    EA: float = 70e9 * 1e-4
+    rho_a: float = 2700 * 1e-4
+    supports: tuple = ("fixed", "free")
+    elements: int = 4000
+    rigidity: object = None
+    mass: object = None
+    point_masses: list = field(default_factory=list)
+    point_springs: list = field(default_factory=list)
+
+    def measure(self, n_modes, sensors, *, shape_noise=0.003, freq_noise=0.0005, seed=0):
+        n, h = self.elements, self.length / self.elements
+        g, w = np.polynomial.legendre.leggauss(6)
+        s = 0.5 * (g + 1.0)
+        w = 0.5 * w * h
+        x = (np.arange(n)[:, None] + s[None, :]) * h
+        ea = self.EA * (self.rigidity(x) if self.rigidity else np.ones_like(x))
+        ra = self.rho_a * (self.mass(x) if self.mass else np.ones_like(x))
+        N = np.stack([1 - s, s], -1)
+        B = np.array([-1.0, 1.0]) / h
+        ke = np.einsum("eq,q,i,j->eij", ea, w, B, B)
+        me = np.einsum("eq,q,qi,qj->eij", ra, w, N, N)
+        K = np.zeros((n + 1, n + 1))
+        M = np.zeros((n + 1, n + 1))
+        for a in range(2):
+            for b in range(2):
+                np.add.at(K, (np.arange(n) + a, np.arange(n) + b), ke[:, a, b])
+                np.add.at(M, (np.arange(n) + a, np.arange(n) + b), me[:, a, b])
+        for xp, value, target in ([(xp, m, M) for xp, m in self.point_masses]
+                                  + [(xp, k, K) for xp, k in self.point_springs]):
+            e = min(int(xp / h), n - 1)
+            shape = np.array([1 - (xp / h - e), xp / h - e])
+            target[e:e + 2, e:e + 2] += value * np.outer(shape, shape)
+        fixed = [i for i, sup in ((0, self.supports[0]), (n, self.supports[1]))
+                 if sup == "fixed"]
+        free = np.setdiff1d(np.arange(n + 1), fixed)
+        Kf, Mf = sp.csc_matrix(K[np.ix_(free, free)]), sp.csc_matrix(M[np.ix_(free, free)])
+        lam, vec = spla.eigsh(Kf, k=n_modes, M=Mf, sigma=-1.0, which="LM",
+                              v0=np.ones(free.size))
+        order = np.argsort(lam)
+        full = np.zeros((n + 1, n_modes))
+        full[free] = vec[:, order]
+        shapes = np.stack([np.interp(sensors, np.linspace(0, self.length, n + 1), full[:, j])
+                           for j in range(n_modes)], 1)
+        freqs = np.sqrt(np.maximum(lam[order], 0.0)) / (2 * np.pi)
+        return add_noise(freqs, shapes, shape_noise, freq_noise, seed)

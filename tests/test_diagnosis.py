@@ -121,3 +121,21 @@ def test_data_the_model_fits_are_consistent_and_no_support_effect_is_called():
     mass = next(f for f in result.fits if f.name == "point_mass")
     if min(mass.parameters["position"], L - mass.parameters["position"]) < 0.005:
         assert mass.size_sigmas < 3
+
+
+def test_a_bar_is_diagnosed_with_no_options():
+    """Only the effects that apply to bars are tried (no crack, shear, axial load,
+    foundation or support spring), and an attached mass is found."""
+    from .conftest import STEEL_BAR
+    from .reference import ReferenceBar
+
+    model = make_model(STEEL_BAR, elements=40, mass="minimum_error")
+    s = np.linspace(0.05, 2.0, 40)
+    f, y = ReferenceBar(elements=4000, point_masses=[(1.2, 0.1)]).measure(5, s, seed=4)
+    added, last, fitted = loop(model, make_measured(s, "u", f, y, "bar"), steps=2)
+    assert [f.name for f in added] == ["point_mass"]
+    mass = fitted.effects[0].parameters
+    assert abs(mass["position"] - 1.2) < 0.02 and abs(mass["mass"] / 0.1 - 1) < 0.05
+    tried = {f.name for f in last.fits} | {f.name for f in last.failed}
+    assert not tried & {"crack", "shear", "axial_load", "foundation", "support_spring"}
+    assert last.verdict == "consistent"

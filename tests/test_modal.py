@@ -115,12 +115,66 @@ def test_cracked_beam_frequency_ratios_match_reference():
     assert np.allclose(ratio, [0.757, 0.9985, 0.8321], atol=6e-4)
 
 
-def test_fine_mesh_keeps_accuracy():
-    # raw shift-invert eigenvalues lose ~eps N^4 (1e-3 at N = 3000); see modal.py
-    m = make_model(elements=10000)
+SUPPORT_ROOTS = {
+    ("pinned", "pinned"): lambda n: np.arange(1, n + 1) * np.pi,
+    ("clamped", "clamped"): lambda n: _roots(lambda b: np.cos(b) * np.cosh(b) - 1, n),
+    ("clamped", "free"): lambda n: _roots(lambda b: np.cos(b) * np.cosh(b) + 1, n),
+}
+
+
+@pytest.mark.parametrize("elements", [1000, 10000, 30000])
+@pytest.mark.parametrize("supports", list(SUPPORT_ROOTS))
+def test_fine_meshes_keep_the_closed_forms(elements, supports):
+    """The condensed, self-checking route: within 1e-6 (measured: 6e-9 at 30 000) where
+    raw shift-invert loses eps N^4 (1e-3 at 3000 elements, wrong at 20 000)."""
+    m = make_model(elements=elements, supports=dict(zip(("left", "right"), supports)))
     f = model_modes(m, 5).frequencies_hz
-    exact = _beam_omega(m, np.arange(1, 6) * np.pi) / (2 * np.pi)
-    assert np.allclose(f, exact, rtol=1e-6)
+    exact = _beam_omega(m, SUPPORT_ROOTS[supports](5)) / (2 * np.pi)
+    assert np.max(np.abs(f / exact - 1)) < 1e-6
+
+
+def test_meshes_above_the_verified_ceiling_are_refused_with_the_limit():
+    from gfe_opt.errors import GfeInputError
+    from gfe_opt.modal import MAX_BEAM_ELEMENTS
+
+    with pytest.raises(GfeInputError, match=f"above {MAX_BEAM_ELEMENTS}, the finest mesh"):
+        model_modes(make_model(elements=MAX_BEAM_ELEMENTS + 1), 5)
+
+
+def test_solves_are_deterministic():
+    beam = make_model(elements=3000)  # condensed route
+    bar = make_model(STEEL_BAR, elements=20000)  # sparse shift-invert route
+    for model in (beam, bar):
+        a, b = model_modes(model, 5), model_modes(model, 5)
+        assert np.array_equal(a.frequencies_hz, b.frequencies_hz)
+        assert np.array_equal(a.shapes, b.shapes)
+
+
+def test_a_long_bar_keeps_its_closed_form():
+    m = make_model(STEEL_BAR, elements=200000, mass="minimum_error")
+    f = model_modes(m, 5).frequencies_hz
+    c = np.sqrt(m.axial_rigidity / m.mass_per_length)
+    exact = (2 * np.arange(1, 6) - 1) * np.pi / (2 * m.length) * c / (2 * np.pi)
+    assert np.max(np.abs(f / exact - 1)) < 1e-9
+
+
+def test_rigid_body_modes_are_counted_for_every_support_and_spring():
+    from gfe_opt.modal import rigid_body_count
+
+    supports = ("pinned", "clamped", "free", "sliding")
+    count = {(a, b): rigid_body_count(discretise(make_model(
+        supports={"left": a, "right": b}))) for a in supports for b in supports}
+    assert count[("free", "free")] == 2
+    assert count[("pinned", "free")] == count[("free", "sliding")] == 1
+    assert count[("sliding", "sliding")] == 1 and count[("pinned", "pinned")] == 0
+    free = make_model(supports={"left": "free", "right": "free"})
+    # one spring leaves the turn about it; a foundation leaves nothing
+    spring = free.with_effects([Effect("point_spring", {"position": 0.1, "stiffness": 1e5})])
+    found = free.with_effects([Effect("foundation", {"stiffness": 1e5})])
+    assert rigid_body_count(discretise(spring)) == 1
+    assert rigid_body_count(discretise(found)) == 0
+    f = model_modes(spring, 3).frequencies_hz
+    assert f[0] == 0.0 and f[1] > 10.0
 
 
 def _ss_exact(model, n, extra_stiffness=0.0, tension=0.0):

@@ -40,5 +40,9 @@ def test_compare_solvers(tmp_path):
 
 
 def test_bench_eigen_accuracy(tmp_path):
-    rows = json.loads(_run("bench_eigen_accuracy.py", cwd=tmp_path))
-    assert rows[-1]["gfe_opt_max_rel_error"] < 1e-6 < rows[-1]["raw_shift_invert_max_rel_error"]
+    out = json.loads(_run("bench_eigen_accuracy.py", "--max-elements", "10000", cwd=tmp_path))
+    for row in out["rows"]:
+        assert row["gfe_opt_max_rel_error"] < 1e-6
+    raw = [r["raw_shift_invert_max_rel_error"] for r in out["rows"] if r["elements"] == 10000]
+    assert all(isinstance(e, str) or e > 1e-4 for e in raw)  # raw shift-invert fails there
+    assert "the finest mesh whose modal solve gfe-opt verifies" in out["above_ceiling"]
