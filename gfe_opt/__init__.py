@@ -9,15 +9,32 @@ The stages are separate calls with plain data between them::
     outcome = update(model, measured, ["crack"])
 """
 
-from .correlation import Comparison, compare, mac
-from .diagnosis import Diagnosis, UpdateOutcome, diagnose, update
-from .effects import EFFECTS, EffectType, register_effect
-from .errors import GfeInputError, GfeSolverError
-from .measured import MeasuredModes, load_measured, save_measured
-from .modal import Modes, model_modes
-from .model import Effect, Model, load_model, save_model
+from importlib import import_module
 
-__all__ = ["Comparison", "Diagnosis", "EFFECTS", "Effect", "EffectType", "GfeInputError",
-           "GfeSolverError", "MeasuredModes", "Model", "Modes", "UpdateOutcome", "compare",
-           "diagnose", "load_measured", "load_model", "mac", "model_modes", "register_effect",
-           "save_measured", "save_model", "update"]
+from .errors import GfeInputError, GfeSolverError  # noqa: F401 (public, light)
+
+#: public names and the module each lives in, imported on first use (PEP 562): the command
+#: line starts without numerical libraries, so even an early Ctrl-C is one line
+_LAZY = {
+    "Comparison": "correlation", "compare": "correlation", "mac": "correlation",
+    "Diagnosis": "diagnosis", "UpdateOutcome": "diagnosis", "diagnose": "diagnosis",
+    "update": "diagnosis",
+    "EFFECTS": "effects", "EffectType": "effects", "register_effect": "effects",
+    "MeasuredModes": "measured", "load_measured": "measured", "save_measured": "measured",
+    "Modes": "modal", "model_modes": "modal",
+    "Effect": "model", "Model": "model", "load_model": "model", "save_model": "model",
+}
+
+__all__ = sorted([*_LAZY, "GfeInputError", "GfeSolverError"])
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'gfe_opt' has no attribute {name!r}")
+
+
+def __dir__():
+    return __all__

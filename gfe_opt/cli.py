@@ -1,7 +1,8 @@
 """The ``gfe-opt`` command line.
 
 Exit codes: 0 success, 1 a solver failed (its status is printed), 2 bad input (one line on
-stderr naming the file, the field and the fault; no traceback).
+stderr naming the file, the field and the fault; no traceback), 130 interrupted (Ctrl-C), 70
+an internal error (a bug: one line, never a traceback).
 """
 
 from __future__ import annotations
@@ -310,23 +311,44 @@ def cmd_demo(args) -> int:
 
 
 def main(argv=None) -> int:
-    parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        args = parser.parse_args(argv)
-    except SystemExit as exc:  # usage errors (2) and --help (0) from argparse
-        return int(exc.code or 0)
-    args.argv = argv
-    np.seterr(all="ignore")
-    try:
-        return {"compare": cmd_compare, "diagnose": cmd_diagnose, "update": cmd_update,
-                "modes": cmd_modes, "demo": cmd_demo}[args.command](args)
+        parser = build_parser()
+        try:
+            args = parser.parse_args(argv)
+        except SystemExit as exc:  # usage errors (2) and --help (0) from argparse
+            return int(exc.code or 0)
+        args.argv = argv
+        with np.errstate(all="ignore"):
+            return {"compare": cmd_compare, "diagnose": cmd_diagnose, "update": cmd_update,
+                    "modes": cmd_modes, "demo": cmd_demo}[args.command](args)
     except GfeInputError as exc:
-        print(f"gfe-opt: error: {exc}", file=sys.stderr)
+        print(f"gfe-opt: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     except GfeSolverError as exc:
-        print(f"gfe-opt: solver failed: {exc}", file=sys.stderr)
+        print(f"gfe-opt: solver failed: {_one_line(exc)}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print("gfe-opt: interrupted (nothing half-written: outputs are written whole or not "
+              "at all)", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except MemoryError:
+        print("gfe-opt: error: out of memory: use fewer elements, sensors or modes (README "
+              "\"Limits\")", file=sys.stderr)
+        return 2
+    except Exception as exc:  # a bug: one line, not a traceback; the fuzzer looks for these
+        print(f"gfe-opt: internal error (a bug, please report it with the command): "
+              f"{type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_INTERNAL_ERROR
+
+
+#: exit codes besides 0 (success), 1 (a solver failed) and 2 (bad input)
+EXIT_INTERRUPTED = 130
+EXIT_INTERNAL_ERROR = 70
+
+
+def _one_line(exc) -> str:
+    return " ".join(str(exc).split())
 
 
 if __name__ == "__main__":

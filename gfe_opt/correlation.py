@@ -33,7 +33,7 @@ from scipy.optimize import linear_sum_assignment
 
 from .assembly import Discretisation, discretise
 from .errors import GfeInputError, GfeSolverError
-from .measured import MeasuredModes, sensor_matrix
+from .measured import MeasuredModes, on_model, sensor_matrix
 from .modal import Modes, discretisation_modes, rigid_body_count
 from .model import Model
 
@@ -175,7 +175,10 @@ def _tikhonov_sparse(D, C, y, noise):
     # α has the units of the receptance G = C D⁻¹ Cᵀ: bracket it about an estimate of ‖G‖;
     # the misfit grows with α: regula falsi (Illinois) on log α, to 1e-4 in the misfit
     probe = np.ones(s) / np.sqrt(s)
-    g_norm = np.linalg.norm(C @ spla.splu(D).solve(C.T @ probe))
+    try:
+        g_norm = np.linalg.norm(C @ spla.splu(D).solve(C.T @ probe))
+    except RuntimeError:  # ω exactly a model eigenvalue: bracket with the mass scale
+        g_norm = 1.0 / scale**2
     a, b = np.log(1e-9 * g_norm), np.log(1e3 * g_norm)
     phi, lam, fa = solve(a)
     if fa >= 0:
@@ -238,19 +241,39 @@ def check_model_size(disc: Discretisation, measured: MeasuredModes, where: str =
 
 
 def check_frequency_units(measured: MeasuredModes, model_hz) -> None:
-    """Reject measured frequencies that differ from the model's by a factor that points to
-    wrong units (rad/s for Hz, kHz, a model in millimetres): the measured first frequency
-    outside [1/20, 20] times the model's first non-zero one."""
+    """Reject measured frequencies whose ratio to the model's (median over the modes in
+    order, elastic ones only) points to wrong units: close to 2π (rad/s given as Hz), to
+    1/2π (Hz divided by 2π), or outside [1/20, 20] (kHz, a model in millimetres, or the
+    wrong model)."""
     model_hz = np.asarray(model_hz)
     positive = model_hz[model_hz > 0]
     if positive.size == 0:
         return
-    ratio = measured.frequencies_hz[0] / positive[0]
+    k = min(positive.size, measured.n_modes)
+    ratio = float(np.median(measured.frequencies_hz[:k] / positive[:k]))
+    where, first = measured.source, measured.frequencies_hz[0]
+    if abs(ratio / (2 * np.pi) - 1) < 0.1:
+        raise GfeInputError(where, "modes[0].frequency", f"{first:.4g} Hz: the measured "
+                            f"frequencies are {ratio:.3g} times the model's, close to 2π: "
+                            "given in rad/s? Frequencies are in Hz")
+    if abs(ratio * 2 * np.pi - 1) < 0.1:
+        raise GfeInputError(where, "modes[0].frequency", f"{first:.4g} Hz: the measured "
+                            f"frequencies are 1/{1 / ratio:.3g} of the model's, close to "
+                            "1/2π: divided by 2π twice? Frequencies are in Hz")
     if not 0.05 <= ratio <= 20.0:
-        raise GfeInputError(measured.source, "modes[0].frequency",
-                            f"{measured.frequencies_hz[0]:.4g} Hz is {ratio:.3g} times the "
-                            f"model's first frequency {positive[0]:.4g} Hz: wrong units "
-                            "(rad/s or kHz for Hz, millimetres for metres) or wrong model?")
+        hint = ("in kHz? " if abs(np.log10(ratio) + 3) < 0.5 else
+                "in mHz? " if abs(np.log10(ratio) - 3) < 0.5 else "")
+        raise GfeInputError(where, "modes[0].frequency", f"{first:.4g} Hz is {ratio:.3g} "
+                            f"times the model's first frequency {positive[0]:.4g} Hz: {hint}"
+                            "wrong units (rad/s or kHz for Hz, millimetres for metres) or "
+                            "wrong model?")
+
+
+def check_units(model, measured: MeasuredModes) -> None:
+    """:func:`check_frequency_units` against the model's own modes."""
+    disc = discretise(model)
+    n = min(measured.n_modes + rigid_body_count(disc), len(disc.free) - 1)
+    check_frequency_units(measured, discretisation_modes(disc, n).frequencies_hz)
 
 
 @dataclass(frozen=True)
@@ -321,6 +344,7 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
     ``noise`` is the relative shape noise δ used to regularise the expansion.
     """
     disc = discretise(model) if disc is None else disc
+    measured, dropped = on_model(measured, model)
     check_model_size(disc, measured, model.source or model.name)
     C = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
     n_free = len(disc.free)
@@ -342,13 +366,20 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
                                   / measured.frequencies_hz[t]),
                   mac=float(mac_matrix[t, m])) for t, m in pairs_idx]
     unpaired = sorted(set(range(measured.n_modes)) - {t for t, _ in pairs_idx})
-    notes = []
+    notes = list(dropped)
     if unpaired:
         notes.append(f"test mode(s) {[u + 1 for u in unpaired]} have no model mode with "
                      f"MAC >= {mac_threshold}")
     if not pairs_idx:
         raise GfeSolverError("no test mode pairs with any model mode "
                              f"(MAC >= {mac_threshold}); check sensors and units")
+    for p in pairs:
+        ratio = p.test_hz / p.model_hz
+        if not 0.05 <= ratio <= 20.0:
+            raise GfeInputError(measured.source, f"modes[{p.test_mode - 1}].frequency",
+                                f"{p.test_hz:.4g} Hz is {ratio:.3g} times the frequency of "
+                                f"the model mode its shape pairs with ({p.model_hz:.4g} Hz): "
+                                "a typo or wrong units?")
     t_idx = [t for t, _ in pairs_idx]
     m_idx = [m for _, m in pairs_idx]
     expansion = expand_modes(disc, C, measured.omega[t_idx], measured.shapes[:, t_idx],

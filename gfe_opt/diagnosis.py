@@ -60,7 +60,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import chdtri
 
-from .correlation import check_model_size, compare
+from .correlation import check_model_size, check_units, compare
 from .effects import candidate_names, effect_type
 from .errors import GfeInputError, GfeSolverError
 from .fitting import (
@@ -75,7 +75,7 @@ from .fitting import (
     noise_of,
     slots_for,
 )
-from .measured import MeasuredModes, sensor_matrix
+from .measured import MeasuredModes, on_model, sensor_matrix
 from .model import Effect, Model, check_repeats, validate_effect
 
 __all__ = ["DEFAULT_FREQ_NOISE", "DEFAULT_SHAPE_NOISE", "Diagnosis", "UpdateOutcome",
@@ -284,13 +284,21 @@ def _run_jobs(jobs, progress, labels):
         if workers < 2:
             raise OSError("one core")
         context = multiprocessing.get_context("fork")
-        with ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                                 initializer=_single_threaded_blas) as pool:
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                   initializer=_single_threaded_blas)
+        try:
             futures = {pool.submit(_job, job): i for i, job in enumerate(jobs)}
             for done, future in enumerate(as_completed(futures), start=1):
                 results[futures[future]] = future.result()
                 if progress:
                     progress(done, len(jobs), labels[futures[future]])
+        except BaseException:
+            # Ctrl-C or a failure: no worker is left behind
+            for process in list(getattr(pool, "_processes", {}).values()):
+                process.terminate()
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+        pool.shutdown(wait=True)
     except (OSError, ValueError, BrokenProcessPool):
         for i, job in enumerate(jobs):
             if results[i] is None:
@@ -301,9 +309,13 @@ def _run_jobs(jobs, progress, labels):
 
 
 def _single_threaded_blas():
-    """One BLAS thread per worker: the matrices are small and the workers share the cores."""
+    """One BLAS thread per worker: the matrices are small and the workers share the cores.
+    Workers ignore Ctrl-C: the main process ends them (one line, no worker tracebacks)."""
+    import signal
+
     from threadpoolctl import threadpool_limits
 
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     global _BLAS_LIMIT
     _BLAS_LIMIT = threadpool_limits(limits=1)
 
@@ -383,6 +395,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     start = time.perf_counter()
     noise = noise_of(freq_noise, shape_noise)
     names = _candidates(model, candidates)
+    measured, dropped = on_model(measured, model)
     check_model_size(_discretise(model), measured, model.source or model.name)
     C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     baseline = misfit(model, measured, noise, C)
@@ -433,7 +446,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     material = next((f for f in fits if effect_type(f.name).uniform_reference), None)
     _judge(fits, sel, material, model)
 
-    notes = []
+    notes = list(dropped)
     words = nodal = None
     best = _best(fits, sel)
 
@@ -650,6 +663,7 @@ class UpdateOutcome:
     model: Model
     fit: Fit
     added: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
 
     def to_json(self) -> dict:
         """The ``update --json`` contract."""
@@ -703,7 +717,9 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     from the diagnosis of that effect alone.  A global effect already in the model, or
     added twice, is an error."""
     noise = noise_of(freq_noise, shape_noise)
+    measured, dropped = on_model(measured, model)
     check_model_size(_discretise(model), measured, model.source or model.name)
+    check_units(model, measured)
     effects = [parse_effect(a, model) if isinstance(a, str) else a for a in add]
     for e in effects:
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
@@ -739,7 +755,8 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     if not fit.success:
         raise GfeSolverError(f"IPOPT did not fit the effects ({fit.status})")
     return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit,
-                         added=list(range(len(model.effects), len(fit.effects))))
+                         added=list(range(len(model.effects), len(fit.effects))),
+                         notes=dropped)
 
 
 def _default_fixed(kind, model):

@@ -31,9 +31,12 @@ import scipy.sparse as sp
 
 from . import elements as el
 from .errors import GfeInputError
+from .inputs import MAX_MEASURED_MODES, MAX_SENSORS, check_input_file, read_text
 from .outputs import atomic_write, check_output_path
 
 DOFS = ("w", "u")
+#: measured frequencies above this are not structural modes
+MAX_FREQUENCY_HZ = 1e8
 
 
 @dataclass(frozen=True)
@@ -70,15 +73,25 @@ def make_measured(x, dof, frequencies_hz, shapes, source="measured") -> Measured
     x = _finite_array(x, source, "sensors.x", ndim=1)
     if x.size == 0:
         raise GfeInputError(source, "sensors.x", "no sensors")
+    if x.size > MAX_SENSORS:
+        raise GfeInputError(source, "sensors.x", f"{x.size} sensors is above the limit of "
+                            f"{MAX_SENSORS}")
     if np.unique(x).size != x.size:
         dup = x[np.flatnonzero(np.diff(np.sort(x)) == 0)[0]]
         raise GfeInputError(source, "sensors.x", f"sensor position {dup:g} m appears twice")
     f = _finite_array(frequencies_hz, source, "frequency", ndim=1)
     if f.size == 0:
         raise GfeInputError(source, "modes", "no modes")
+    if f.size > MAX_MEASURED_MODES:
+        raise GfeInputError(source, "modes", f"{f.size} modes is above the limit of "
+                            f"{MAX_MEASURED_MODES} measured modes")
     if np.any(f <= 0):
         i = int(np.flatnonzero(f <= 0)[0])
         raise GfeInputError(source, f"modes[{i}].frequency", f"must be > 0 Hz, got {f[i]:g}")
+    if np.any(f > MAX_FREQUENCY_HZ):
+        i = int(np.flatnonzero(f > MAX_FREQUENCY_HZ)[0])
+        raise GfeInputError(source, f"modes[{i}].frequency", f"{f[i]:g} Hz is above "
+                            f"{MAX_FREQUENCY_HZ:g} Hz: not a structural mode (a typo?)")
     shapes = _finite_array(shapes, source, "shape", ndim=2)
     if shapes.shape != (x.size, f.size):
         raise GfeInputError(source, "shape", f"expected {x.size} values per mode (one per "
@@ -119,9 +132,7 @@ def load_measured(path, dof: str | None = None) -> MeasuredModes:
 
     ``dof`` is needed only where the file does not say it (CSV; defaults to ``"w"``).
     """
-    path = Path(path)
-    if not path.is_file():
-        raise GfeInputError(str(path), None, "no such file")
+    path = check_input_file(path, "measured")
     suffix = path.suffix.lower()
     if suffix == ".json":
         return _read_json(path)
@@ -136,11 +147,11 @@ def load_measured(path, dof: str | None = None) -> MeasuredModes:
 def _read_json(path: Path) -> MeasuredModes:
     where = str(path)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise GfeInputError(where, None, f"cannot read ({exc})") from None
+        data = json.loads(read_text(path, "measured"))
     except json.JSONDecodeError as exc:
         raise GfeInputError(where, None, f"not valid JSON ({exc})") from None
+    except RecursionError:
+        raise GfeInputError(where, None, "not valid JSON (nested too deeply)") from None
     if not isinstance(data, dict):
         raise GfeInputError(where, None, "top level must be an object with sensors and modes")
     for key in data:
@@ -183,11 +194,8 @@ def _is_number(v):
 
 def _read_csv(path: Path, dof: str) -> MeasuredModes:
     where = str(path)
-    try:
-        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines()
-                 if ln.strip() and not ln.lstrip().startswith("#")]
-    except (OSError, UnicodeDecodeError) as exc:
-        raise GfeInputError(where, None, f"cannot read ({exc})") from None
+    lines = [ln for ln in read_text(path, "measured").splitlines()
+             if ln.strip() and not ln.lstrip().startswith("#")]
     rows = list(csv.reader(lines))
     if len(rows) < 2:
         raise GfeInputError(where, None, "needs a header row of frequencies and sensor rows")
@@ -330,6 +338,30 @@ def _write_uff(m: MeasuredModes, path) -> None:
 # -------------------------------------------------------------------------------------------
 # Mapping sensors onto a model
 # -------------------------------------------------------------------------------------------
+
+
+def on_model(measured: MeasuredModes, model) -> tuple[MeasuredModes, list[str]]:
+    """The measured modes without sensors on an end whose support holds the measured DOF
+    still (they read only noise, and would point the localisation at the support), and a
+    note saying which were dropped."""
+    from .effects.base import FIXED_TRANSLATION
+
+    tol = 1e-6 * model.length
+    held = [x for x, support in ((0.0, model.supports[0]), (model.length, model.supports[1]))
+            if support in FIXED_TRANSLATION]
+    drop = np.zeros(measured.n_sensors, dtype=bool)
+    for x in held:
+        drop |= np.abs(measured.x - x) <= tol
+    if not np.any(drop):
+        return measured, []
+    if np.all(drop):
+        raise GfeInputError(measured.source, "sensors.x", "every sensor sits on a support "
+                            "that holds the structure still: nothing to compare")
+    kept = make_measured(measured.x[~drop], measured.dof, measured.frequencies_hz,
+                         measured.shapes[~drop], measured.source)
+    where = ", ".join(f"x = {x:g} m" for x in measured.x[drop])
+    return kept, [f"sensor{'s' if drop.sum() > 1 else ''} at {where} on a support that holds "
+                  "the structure still: left out (it reads only noise)"]
 
 
 def sensor_matrix(nodes, kind: str, x, dof: str, source="measured") -> sp.csr_matrix:

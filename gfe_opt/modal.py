@@ -40,6 +40,7 @@ import scipy.sparse.linalg as spla
 from . import elements as el
 from .assembly import Discretisation, discretise
 from .errors import GfeInputError, GfeSolverError
+from .inputs import MAX_ELEMENTS
 from .model import Model
 
 #: Up to this many free DOFs a dense generalised eigensolver is used.
@@ -53,7 +54,7 @@ CONDENSATION_TOLERANCE = 1e-3
 #: The finest beam mesh whose modal solve is verified: simply supported, clamped and
 #: cantilever closed forms within 6e-9 at 30 000 elements (tests/test_modal.py); at
 #: 40 000 the cantilever's first frequencies are 2e-6 off (rounding grows as N³).
-MAX_BEAM_ELEMENTS = 30_000
+MAX_BEAM_ELEMENTS = MAX_ELEMENTS["beam"]
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,7 @@ The file form is a contract (see README, "Model file")::
 
 from __future__ import annotations
 
+import math
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -151,16 +152,16 @@ class Model:
 
 def load_model(path) -> Model:
     """Read and validate a model TOML file; raises :class:`GfeInputError` on bad input."""
-    path = Path(path)
+    from .inputs import read_text
+
     where = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise GfeInputError(where, None, f"cannot read model file ({exc.strerror})") from None
+    text = read_text(path, "model")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise GfeInputError(where, None, f"not valid TOML ({exc})") from None
+    except RecursionError:
+        raise GfeInputError(where, None, "not valid TOML (nested too deeply)") from None
     return model_from_dict(data, where)
 
 
@@ -168,6 +169,8 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
     """Build a :class:`Model` from the parsed TOML mapping (same validation as files)."""
     no_unknown(data, {"name", "kind", "length", "elements", "material", "section",
                        "supports", "effects", "mass"}, where, "")
+    if not isinstance(data, dict):
+        raise GfeInputError(where, None, "must be a table of keys")
     kind = _choice(data, "kind", ("beam", "bar"), where)
     length = _number(data, "length", where, positive=True)
     elements = data.get("elements")
@@ -175,6 +178,12 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         raise GfeInputError(where, "elements", "missing (number of elements, an integer >= 1)")
     if isinstance(elements, bool) or not isinstance(elements, int) or elements < 1:
         raise GfeInputError(where, "elements", f"must be an integer >= 1, got {elements!r}")
+    from .inputs import MAX_ELEMENTS
+
+    if kind in MAX_ELEMENTS and elements > MAX_ELEMENTS[kind]:
+        raise GfeInputError(where, "elements", f"{elements} is above {MAX_ELEMENTS[kind]}, the "
+                            f"finest {kind} mesh gfe-opt solves (README \"Limits\"); a few "
+                            "thousand elements resolve the first modes to 1e-9")
     name = data.get("name", Path(where).stem)
     if not isinstance(name, str):
         raise GfeInputError(where, "name", f"must be a string, got {name!r}")
@@ -198,6 +207,7 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         no_unknown(section, {"shape", "b", "h"}, where, "section.")
         breadth = _number(section, "b", where, positive=True, prefix="section.")
         depth = _number(section, "h", where, positive=True, prefix="section.")
+        _check_proportions(length, breadth, depth, where)  # before b·h³ can overflow
         area, inertia = breadth * depth, breadth * depth**3 / 12.0
     else:
         no_unknown(section, {"A", "I", "h"}, where, "section.")
@@ -220,10 +230,13 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         raise GfeInputError(where, "mass", f"unknown mass model {mass_model!r} "
                             f"(known for a {kind}: {', '.join(mass_models)})")
 
-    if depth is not None and not 1.0 <= length / depth <= 2000.0:
-        raise GfeInputError(where, "length", f"length / depth = {length / depth:.4g} is not a "
-                            "beam or bar (expected 1 to 2000): are length and section in the "
-                            "same unit (metres)?")
+    _check_proportions(length, breadth, depth, where)
+    size = math.sqrt(area) / length if math.isfinite(area) else math.inf
+    gyration = math.sqrt(inertia / area) / length if kind == "beam" and size > 0 else 0.5
+    if not (1e-5 <= size <= 1.0 and 1e-6 <= gyration <= 1.0):
+        raise GfeInputError(where, "section", f"A = {area:g} m^2 and I = {inertia:g} m^4 do "
+                            f"not fit a {length:g} m long {kind} (√A and √(I/A) between 1e-5 "
+                            "and 1 of the length): is the section in metres?")
     if not 1e7 <= E <= 1e13:
         raise GfeInputError(where, "material.E", f"{E:g} Pa is outside 1e7..1e13 Pa: give E in "
                             "Pa (206e9 for steel, not 206 or 206e3)")
@@ -248,6 +261,21 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         effects.append(Effect(name_, validate_effect(model, name_, raw, where, f"effects[{i}].")))
     check_repeats(effects, where)
     return replace(model, effects=tuple(effects))
+
+
+def _check_proportions(length, breadth, depth, where) -> None:
+    """Plausible sizes in metres: a length of 1e-6..1e4 m, length / depth 1..2000, length /
+    breadth 1..1e5 (a wrong unit, not a beam, otherwise)."""
+    if not 1e-6 <= length <= 1e4:
+        raise GfeInputError(where, "length", f"{length:g} m is outside 1e-6..1e4 m: give the "
+                            "length in metres")
+    if depth is not None and not 1.0 <= length / depth <= 2000.0:
+        raise GfeInputError(where, "length", f"length / depth = {length / depth:.4g} is not a "
+                            "beam or bar (expected 1 to 2000): are length and section in the "
+                            "same unit (metres)?")
+    if breadth is not None and not 1.0 <= length / breadth <= 1e5:
+        raise GfeInputError(where, "section.b", f"length / breadth = {length / breadth:.4g} is "
+                            "not a beam (expected 1 to 1e5): is the section in metres?")
 
 
 def validate_effect(model: Model, name: str, params: dict, where: str, prefix: str = "",

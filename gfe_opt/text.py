@@ -110,6 +110,7 @@ def format_update(outcome) -> str:
         mark = "added" if i in outcome.added else "re-estimated"
         lines.append(f"  {e.name} ({mark}): {effect_type(e.name).describe(e.parameters, sigma)}")
     lines.append(misfit_line(outcome.after, "after"))
+    lines += [f"note: {n}" for n in outcome.notes]
     return "\n".join(lines)
 
 

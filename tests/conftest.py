@@ -3,8 +3,16 @@
 import copy
 
 import pytest
+from hypothesis import settings
 
 from gfe_opt.model import model_from_dict
+
+# hypothesis profiles: "ci" (default, the fuzzer's few thousand examples in about a minute)
+# and "long" (python scripts/fuzz.py, or --hypothesis-profile long); tests that set their own
+# max_examples keep it
+settings.register_profile("ci", max_examples=1500, deadline=None)
+settings.register_profile("long", max_examples=30000, deadline=None)
+settings.load_profile("ci")
 
 STEEL_BEAM = {
     "name": "ss-steel-beam", "kind": "beam", "length": 0.575, "elements": 46,

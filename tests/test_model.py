@@ -87,6 +87,6 @@ def test_bad_effects(tmp_path, effect, match):
 
 
 def test_missing_file_is_input_error(tmp_path):
-    with pytest.raises(GfeInputError, match="cannot read"):
+    with pytest.raises(GfeInputError, match="nope.toml: no such file"):
         load_model(tmp_path / "nope.toml")
     assert issubclass(GfeInputError, ValueError)

@@ -140,6 +140,34 @@ def position_variable() -> Variable:
                     scale=lambda model: model.length)
 
 
+def end_at(model, x: float) -> tuple[str, str] | None:
+    """``("left", support)`` or ``("right", support)`` when x lies on an end, else None."""
+    tol = 1e-9 * model.length
+    if abs(x) <= tol:
+        return "left", model.supports[0]
+    if abs(x - model.length) <= tol:
+        return "right", model.supports[1]
+    return None
+
+
+#: supports that hold the translation still (beam w, bar u): a mass or a spring there does
+#: nothing
+FIXED_TRANSLATION = ("pinned", "clamped", "fixed")
+#: supports where the bending moment vanishes: a crack there changes nothing
+FREE_MOMENT = ("pinned", "free")
+
+
+def check_not_on_support(model, params, where, prefix, name, supports, why):
+    """A point effect on an end whose support makes it meaningless is an error."""
+    if "position" not in params:
+        return
+    end = end_at(model, params["position"])
+    if end is not None and end[1] in supports:
+        raise GfeInputError(where, f"{prefix}position", f"{params['position']:g} m is the "
+                            f"{end[1]} {end[0]} end, where {why}: a {name} there does "
+                            "nothing")
+
+
 def as_float(value, where, field) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise GfeInputError(where, field, f"must be a number, got {value!r}")

@@ -6,7 +6,14 @@ import numpy as np
 
 from .. import elements as el
 from ..errors import GfeInputError
-from .base import EffectType, Parameter, Variable, position_variable
+from .base import (
+    FREE_MOMENT,
+    EffectType,
+    Parameter,
+    Variable,
+    check_not_on_support,
+    position_variable,
+)
 
 #: Q(x) differs from 1 by less than 26 e^-36 (~1e-14) beyond 18 decay lengths
 CRACK_REACH = 18.0
@@ -28,6 +35,8 @@ class Crack(EffectType):
         if model.depth is None:
             raise GfeInputError(where, f"{prefix}effect", "a crack needs the section depth "
                                 "(section.h or shape = 'rectangle')")
+        check_not_on_support(model, params, where, prefix, "crack", FREE_MOMENT,
+                             "the bending moment is zero")
         if params.get("depth_ratio", 0.0) > 0.95:
             raise GfeInputError(where, f"{prefix}depth_ratio", "must lie between 0 and 0.95 "
                                 f"(a/d), got {params['depth_ratio']:g}")

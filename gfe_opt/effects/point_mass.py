@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
-from .base import EffectType, Parameter, Variable, position_variable
+from .base import (
+    FIXED_TRANSLATION,
+    EffectType,
+    Parameter,
+    Variable,
+    check_not_on_support,
+    position_variable,
+)
 
 
 class PointMass(EffectType):
@@ -15,6 +22,10 @@ class PointMass(EffectType):
         Parameter("position", "m", "position", "distance from the left end"),
         Parameter("mass", "kg", "positive", "attached mass", null=0.0),
     )
+
+    def check(self, model, params, where, prefix):
+        check_not_on_support(model, params, where, prefix, "point mass", FIXED_TRANSLATION,
+                             "the support holds the structure still")
 
     def contribute(self, model, params, build):
         build.add_point_mass(params["position"], params["mass"])

@@ -3,7 +3,15 @@ attachment)."""
 
 from __future__ import annotations
 
-from .base import EffectType, Parameter, Variable, nominal_rigidity, position_variable
+from .base import (
+    FIXED_TRANSLATION,
+    EffectType,
+    Parameter,
+    Variable,
+    check_not_on_support,
+    nominal_rigidity,
+    position_variable,
+)
 
 
 def _scale(model):
@@ -22,6 +30,10 @@ class PointSpring(EffectType):
         Parameter("position", "m", "position", "distance from the left end"),
         Parameter("stiffness", "N/m", "positive", "spring stiffness", null=0.0),
     )
+
+    def check(self, model, params, where, prefix):
+        check_not_on_support(model, params, where, prefix, "point spring", FIXED_TRANSLATION,
+                             "the support holds the structure still")
 
     def contribute(self, model, params, build):
         build.add_point_stiffness(params["position"], params["stiffness"])
