@@ -199,9 +199,11 @@ class Builder:
         """A mass m [kg] at x [m] (translation only)."""
         self.point_masses.append((float(x), float(m)))
 
-    def add_end_spring(self, side: str, k: float) -> None:
-        """A rotational spring k [N m/rad] at the ``"left"`` or ``"right"`` end."""
-        self.end_springs.append((side, float(k)))
+    def add_end_spring(self, side: str, k: float, translation: bool = False) -> None:
+        """A spring at the ``"left"`` or ``"right"`` end: rotational k [N m/rad], or with
+        ``translation`` on the deflection (beam w, bar u) k [N/m].  It replaces a fixity of
+        that DOF (a clamp or a pin that gives)."""
+        self.end_springs.append((side, float(k), bool(translation)))
 
     # -- the elements -------------------------------------------------------------------
     def discretisation(self) -> "Discretisation":
@@ -225,10 +227,10 @@ class Builder:
             e, shape = self._shape_at(x)
             mass[e] += m * np.outer(shape, shape)
         nodal = []
-        for side, k in self.end_springs:
+        for side, k, translation in self.end_springs:
             node = 0 if side == "left" else n
-            dof = 2 * node + 1
-            constrained.discard(dof)  # a clamp that gives: the spring replaces the fixity
+            dof = (2 * node if beam else node) if translation else 2 * node + 1
+            constrained.discard(dof)  # a support that gives: the spring replaces the fixity
             nodal.append((dof, k))
         scale = rigidity / (model.mass_per_length * model.length ** (4 if beam else 2))
         return Discretisation(kind=model.kind, nodes=model.nodes, element_length=L,

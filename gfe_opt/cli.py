@@ -178,9 +178,11 @@ def _comparison_report(report, result, model, measured):
                      f"{measured.n_modes} measured modes at {measured.n_sensors} sensors.")
     report.table(["mode", "f_test [Hz]", "f_model [Hz]", "Δf %", "MAC"],
                  [[p.test_mode, f"{p.test_hz:.2f}", f"{p.model_hz:.2f}",
-                   f"{p.error_pct:+.2f}", f"{p.mac:.3f}"] for p in result.pairs])
-    report.paragraph(f"Frequency error {result.freq_error_rms_pct:.2f} % rms, mean MAC "
-                     f"{result.mac_mean:.3f}.")
+                   f"{p.error_pct:+.2f}", "—" if p.mac is None else f"{p.mac:.3f}"]
+                  for p in result.pairs])
+    mac = "" if result.mac_mean is None else f", mean MAC {result.mac_mean:.3f}"
+    report.paragraph(f"Frequency error {result.freq_error_rms_pct:.2f} % rms{mac}.")
+    report.paragraph("; ".join(result.notes))
     for x, rel in result.failure_places():
         report.paragraph(f"The model fails near x = {x:.3f} m "
                          f"({100 * rel:.0f} % of the largest residual force).")

@@ -76,6 +76,20 @@ def pair_modes(mac_matrix, threshold: float = DEFAULT_MAC_THRESHOLD, test_hz=Non
     return sorted(zip(rows[keep].tolist(), cols[keep].tolist()))
 
 
+def pair_by_frequency(test_hz, model_hz) -> list[tuple[int, int]]:
+    """Pair test modes with model modes by frequency alone (a test without usable shapes):
+    one to one, minimising the total |ln(f_model / f_test)| (Hungarian), so each test mode
+    takes the nearest model mode that no closer test mode claims.  Rigid-body model modes
+    (f = 0) are never partners."""
+    test_hz = np.asarray(test_hz, float)
+    model_hz = np.asarray(model_hz, float)
+    cost = np.abs(np.log(np.maximum(model_hz, 1e-300)[None, :] / test_hz[:, None]))
+    cost[:, model_hz <= 0] = 1e6
+    rows, cols = linear_sum_assignment(cost)
+    keep = model_hz[cols] > 0
+    return sorted(zip(rows[keep].tolist(), cols[keep].tolist()))
+
+
 def comac(test, model) -> np.ndarray:
     r"""Coordinate MAC per sensor for paired shapes ``test`` and ``model`` (n_sensors, n_pairs).
 
@@ -283,23 +297,26 @@ class Pair:
     test_hz: float
     model_hz: float
     error_pct: float
-    mac: float
+    mac: float | None   # None: paired by frequency (a test without usable shapes)
 
 
 @dataclass(frozen=True)
 class Comparison:
-    """Result of :func:`compare` (modes numbered from 1 in ``pairs``)."""
+    """Result of :func:`compare` (modes numbered from 1 in ``pairs``).  A test without
+    usable shapes (:attr:`~gfe_opt.measured.MeasuredModes.frequency_only`) is paired by
+    frequency; its MAC matrix, COMAC, residual and expanded shapes are None."""
 
     pairs: list
-    mac_matrix: np.ndarray
+    mac_matrix: np.ndarray | None
     unpaired_test_modes: list
     sensor_x: np.ndarray
-    comac: np.ndarray
-    residual: np.ndarray
-    residual_per_mode: np.ndarray
+    comac: np.ndarray | None
+    residual: np.ndarray | None
+    residual_per_mode: np.ndarray | None
     model_modes: Modes
-    expanded_shapes: np.ndarray
+    expanded_shapes: np.ndarray | None
     notes: list = field(default_factory=list)
+    pairing: str = "mac"
 
     @property
     def freq_error_rms_pct(self) -> float:
@@ -307,17 +324,22 @@ class Comparison:
         return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
 
     @property
-    def mac_mean(self) -> float:
+    def mac_mean(self) -> float | None:
+        if self.pairing == "frequency":
+            return None
         return float(np.mean([p.mac for p in self.pairs])) if self.pairs else float("nan")
 
-    def localisation(self) -> list[dict]:
+    def localisation(self) -> list[dict] | None:
+        if self.residual is None:
+            return None
         return [{"x": float(x), "residual": float(r)} for x, r in zip(self.sensor_x,
                                                                         self.residual)]
 
     def failure_places(self, fraction: float = 0.6, at_most: int = 3) -> list[tuple[float, float]]:
-        """Local maxima of the residual above ``fraction`` of the largest, largest first."""
+        """Local maxima of the residual above ``fraction`` of the largest, largest first
+        (none for a frequency-only test)."""
         r = self.residual
-        if not np.any(r > 0):
+        if r is None or not np.any(r > 0):
             return []
         padded = np.concatenate([[-np.inf], r, [-np.inf]])
         peaks = np.flatnonzero((r >= padded[:-2]) & (r >= padded[2:]) & (r >= fraction * r.max()))
@@ -333,6 +355,7 @@ class Comparison:
             "freq_error_rms_pct": self.freq_error_rms_pct,
             "mac_mean": self.mac_mean,
             "localisation": self.localisation(),
+            "pairing": self.pairing,
         }
 
 
@@ -354,6 +377,8 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
     K, M = disc.global_matrices()
     modes = discretisation_modes(disc, n_model, matrices=(K, M))
     check_frequency_units(measured, modes.frequencies_hz)
+    if measured.frequency_only:
+        return _compare_frequencies(measured, modes, dropped)
     at_sensors = C @ modes.shapes
     mac_matrix = mac(measured.shapes, at_sensors)
     # measured modes vibrate (f > 0): a rigid-body model mode is never their partner
@@ -390,3 +415,19 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
                                                        at_sensors[:, m_idx]),
                       residual=residual, residual_per_mode=expansion.relative_residual,
                       model_modes=modes, expanded_shapes=expansion.shapes, notes=notes)
+
+
+def _compare_frequencies(measured: MeasuredModes, modes: Modes, notes) -> Comparison:
+    """:func:`compare` for a test without usable shapes: pairs by frequency only."""
+    pairs_idx = pair_by_frequency(measured.frequencies_hz, modes.frequencies_hz)
+    pairs = [Pair(test_mode=t + 1, model_mode=m + 1,
+                  test_hz=float(measured.frequencies_hz[t]),
+                  model_hz=float(modes.frequencies_hz[m]),
+                  error_pct=float(100.0 * (modes.frequencies_hz[m] - measured.frequencies_hz[t])
+                                  / measured.frequencies_hz[t]), mac=None)
+             for t, m in pairs_idx]
+    unpaired = sorted(set(range(measured.n_modes)) - {t for t, _ in pairs_idx})
+    return Comparison(pairs=pairs, mac_matrix=None, unpaired_test_modes=unpaired,
+                      sensor_x=measured.x, comac=None, residual=None, residual_per_mode=None,
+                      model_modes=modes, expanded_shapes=None,
+                      notes=[*notes, measured.without_shapes_note()], pairing="frequency")

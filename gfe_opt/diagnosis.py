@@ -107,6 +107,8 @@ def shape_correlation(model: Model, measured: MeasuredModes, noise: Noise, C=Non
     structure), pooled over modes: about 0 for noise, near 1 for a model error."""
     from .fitting import residuals
 
+    if measured.frequency_only:
+        return float("nan")
     r = residuals(model, measured, noise, C)[0]
     if r is None:
         return 1.0
@@ -131,7 +133,7 @@ class NoiseEstimate:
     shape: float
     given: bool
     implied_freq: float
-    implied_shape: float
+    implied_shape: float | None   # None: a frequency-only test
     floor: float
     correlation: float
 
@@ -158,6 +160,7 @@ class Diagnosis:
     noise: NoiseEstimate
     seconds: float
     localisation: list = field(default_factory=list)
+    alike: list = field(default_factory=list)         # effects the data cannot tell apart
     realisation: list = field(default_factory=list)   # the generic update in words
     nodal: list = field(default_factory=list)         # Realisation per node
     generic_update: object = None                     # the UpdateResult they come from
@@ -184,6 +187,7 @@ class Diagnosis:
                             "reason": "; ".join(f.notes), **f.misfit.summary()}
                            for f in self.failed],
                 "skipped": [{"effect": name, "reason": reason} for name, reason in self.skipped],
+                "indistinguishable": [f.name for f in self.alike],
                 "realisation": list(self.realisation),
                 "notes": list(self.notes)}
 
@@ -205,14 +209,22 @@ def fitted_parameter_count(name: str) -> int:
 def check_enough_modes(measured: MeasuredModes, effects) -> None:
     """Each effect needs at least as many measured modes as it has fitted parameters (one
     mode cannot tell a crack's position from its depth); together they need five residuals
-    (frequencies and shape values) per parameter."""
+    (frequencies and shape values) per parameter, or, frequencies alone, one frequency more
+    than they have parameters (else the fit has nothing left to be judged by)."""
     for e in effects:
         need = fitted_parameter_count(e.name)
         if measured.n_modes < need:
             raise GfeInputError(measured.source, "modes", f"{e.name} needs at least {need} "
                                 f"measured modes, the file has {measured.n_modes}")
     total = sum(fitted_parameter_count(e.name) for e in effects)
-    residuals = measured.n_modes * (1 + measured.n_sensors)
+    if measured.frequency_only:
+        if measured.n_modes < total + 1:
+            names = " + ".join(e.name for e in effects)
+            raise GfeInputError(measured.source, "modes", f"{names} has {total} parameters: "
+                                f"{measured.n_modes} measured frequencies alone cannot judge "
+                                f"them ({total + 1} needed)")
+        return
+    residuals = measured.n_values
     if residuals < 5 * total:
         names = " + ".join(e.name for e in effects)
         raise GfeInputError(measured.source, "modes", f"{names} has {total} parameters: the "
@@ -427,7 +439,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     if candidates is not None and not jobs and not fallback_names:
         raise GfeInputError(measured.source, "modes", "; ".join(f"{n}: {r}"
                                                                 for n, r in skipped))
-    with_generic = realise and model.kind == "beam"
+    with_generic = realise and model.kind == "beam" and not measured.frequency_only
     if with_generic:  # the paper's generic update runs beside the candidates
         jobs.append(("generic", (model, measured, noise)))
         labels.append("generic-element update")
@@ -458,8 +470,9 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             return True
         if noise.given:
             return False
-        return (abs(shape_correlation(fit.model, measured, noise, C)) < WHITE_NOISE_CORRELATION
-                and fit.misfit.chi2_freq / max(fit.misfit.n_freq, 1) <= FREQ_NOISE_LIMIT**2)
+        white = (measured.frequency_only or abs(shape_correlation(fit.model, measured, noise, C))
+                 < WHITE_NOISE_CORRELATION)
+        return white and fit.misfit.chi2_freq / max(fit.misfit.n_freq, 1) <= FREQ_NOISE_LIMIT**2
 
     partial = None
     if best is not None and not explains(best) or best is None and not fits_noise(
@@ -515,11 +528,18 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     estimate = _noise_estimate(model, measured, noise, [*ranked, reference], C, ref_misfit,
                                sel.floor)
     verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate)
+    alike = _alike(ranked, sel) if verdict == "effect_found" else []
+    if verdict == "effect_found":
+        notes += _ambiguities(ranked[0], alike, measured, noise, C, sel)
+    if measured.frequency_only:
+        notes.append(measured.without_shapes_note())
+        if realise and model.kind == "beam":
+            notes.append("the generic-element update needs mode shapes: not run")
     notes += _noise_notes(estimate, verdict)
     if skipped:
         notes.append("not tried: " + "; ".join(f"{n} ({r})" for n, r in skipped))
     return Diagnosis(baseline=baseline, reference=reference, fits=ranked, failed=failed,
-                     skipped=skipped, verdict=verdict, noise=estimate,
+                     skipped=skipped, verdict=verdict, noise=estimate, alike=alike,
                      seconds=time.perf_counter() - start, localisation=places,
                      realisation=_words_for_verdict(words or [], verdict),
                      nodal=nodal or [], generic_update=generic, profile_band=band,
@@ -595,6 +615,62 @@ def _generic_update(model, measured, noise):
     return result, band
 
 
+#: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
+ALIKE_CHI2 = quantile(1, 0.05)
+
+
+def _alike(ranked, sel) -> list:
+    """Significant fits other than the best that fit the data as well as it (χ² within
+    :data:`ALIKE_CHI2` noise-floor units): the data cannot tell them apart."""
+    best = ranked[0]
+    return [f for f in ranked[1:] if f.significant and f.name != best.name
+            and f.misfit.chi2 - best.misfit.chi2 < ALIKE_CHI2 * sel.floor]
+
+
+def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
+    """Sentences for what the data cannot decide: effects that fit as well as the best, and
+    (frequencies alone) a local effect's mirror image about mid-span."""
+    notes = []
+    if alike:
+        what = "the frequencies" if measured.frequency_only else "the data"
+        notes.append(f"{what} cannot tell {best.name} from " + ", ".join(
+            f"{f.name} (χ²/n {f.misfit.chi2_per_residual:.3g} against "
+            f"{best.misfit.chi2_per_residual:.3g})" for f in alike)
+            + (": measure mode shapes to decide" if measured.frequency_only else ""))
+    mirror = _mirror(best, measured, noise, C, sel)
+    if mirror is not None:
+        notes.append(mirror)
+    return notes
+
+
+def _mirror(fit, measured, noise, C, sel) -> str | None:
+    """A sentence when the added local effect fits as well at its mirror image (x -> L - x):
+    on a symmetric beam frequencies cannot tell the two apart."""
+    if fit.added is None:
+        return None
+    model = fit.model
+    added = fit.effects[fit.added]
+    x = effect_type(added.name).position(added.parameters)
+    sigma = fit.uncertainty.get("position", 0.0)
+    sigma = sigma if np.isfinite(sigma) else 0.0
+    if x is None or abs(model.length - 2 * x) <= max(2 * sigma, 1e-3 * model.length):
+        return None
+    effects = list(fit.effects)
+    effects[fit.added] = Effect(added.name, {**added.parameters, "position": model.length - x})
+    try:
+        other = model.with_effects(effects)
+    except GfeInputError:
+        return None
+    chi2 = misfit(other, measured, noise, C).chi2
+    if chi2 - fit.misfit.chi2 >= ALIKE_CHI2 * sel.floor:
+        return None
+    fit.mirror_position = model.length - x
+    return (f"the {added.name} at x = {x:.4g} m fits as well at its mirror image "
+            f"x = {model.length - x:.4g} m (χ²/n {chi2 / max(fit.misfit.n_residuals, 1):.3g}):"
+            f" the {'frequencies' if measured.frequency_only else 'data'} cannot tell the two "
+            "places apart")
+
+
 def _noise_estimate(model, measured, noise, fits, C, ref_misfit, floor) -> NoiseEstimate:
     """The noise the data imply: the most flexible fit's frequency and shape residuals
     against their degrees of freedom."""
@@ -603,6 +679,10 @@ def _noise_estimate(model, measured, noise, fits, C, ref_misfit, floor) -> Noise
                                                              1), default=None)
     m = flexible.misfit if flexible else ref_misfit
     p = flexible.n_params if flexible else 0
+    if measured.frequency_only:
+        implied_freq = noise.freq * np.sqrt(m.chi2_freq / max(m.n_freq - p, 1))
+        return NoiseEstimate(noise.freq, noise.shape, noise.given, float(implied_freq), None,
+                             float(floor), float("nan"))
     n_shape = m.n_residuals - m.n_freq
     shape_dof = max(n_shape - p, 1)
     implied_shape = noise.shape * np.sqrt((m.chi2 - m.chi2_freq) / shape_dof)
@@ -617,7 +697,8 @@ def _verdict(ranked, ref_misfit, ref_params, noise, estimate) -> str:
         return "effect_found"
     if fits_noise(ref_misfit, ref_params):
         return "consistent"
-    if (not noise.given and abs(estimate.correlation) < WHITE_NOISE_CORRELATION
+    white = estimate.implied_shape is None or abs(estimate.correlation) < WHITE_NOISE_CORRELATION
+    if (not noise.given and white
             and estimate.implied_freq <= FREQ_NOISE_LIMIT * noise.freq):
         return "consistent"
     return "unexplained"
@@ -625,8 +706,15 @@ def _verdict(ranked, ref_misfit, ref_params, noise, estimate) -> str:
 
 def _noise_notes(est: NoiseEstimate, verdict: str) -> list[str]:
     stated = "stated" if est.given else "assumed"
-    ratio_s = est.implied_shape / est.shape
     ratio_f = est.implied_freq / est.freq
+    if est.implied_shape is None:
+        notes = [f"the data imply frequency noise {100 * est.implied_freq:.2g} % ({stated}: "
+                 f"{100 * est.freq:.2g} %)"]
+        if ratio_f > 1.5 and verdict == "consistent" and not est.given:
+            notes.append("the model agrees with the test at the noise the data imply; give "
+                         "--freq-noise if the test's noise is known")
+        return notes
+    ratio_s = est.implied_shape / est.shape
     line = (f"the data imply shape noise {100 * est.implied_shape:.2g} % and frequency noise "
             f"{100 * est.implied_freq:.2g} % ({stated}: {100 * est.shape:.2g} % and "
             f"{100 * est.freq:.2g} %)")

@@ -40,7 +40,7 @@ import casadi as ca
 import numpy as np
 
 from .assembly import discretise
-from .correlation import mac, pair_modes
+from .correlation import mac, pair_by_frequency, pair_modes
 from .effects import EffectType, effect_type
 from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, sensor_matrix
@@ -88,7 +88,7 @@ class Misfit:
 
     chi2: float
     freq_error_rms_pct: float
-    mac_mean: float
+    mac_mean: float | None        # None: a frequency-only test (no MAC)
     n_residuals: int
     chi2_freq: float = 0.0
     n_freq: int = 0
@@ -106,26 +106,38 @@ class Misfit:
 def misfit(model: Model, measured: MeasuredModes, noise: Noise, C=None) -> Misfit:
     """Weighted residual of ``model`` against ``measured`` (module docstring)."""
     r, f_err, macs = residuals(model, measured, noise, C)
-    n = measured.n_modes * (1 + measured.n_sensors)
+    n = measured.n_values
+    no_mac = None if measured.frequency_only else 0.0
     if r is None:
-        return Misfit(np.inf, np.inf, 0.0, n, np.inf, measured.n_modes)
+        return Misfit(np.inf, np.inf, no_mac, n, np.inf, measured.n_modes)
     freq = r.reshape(measured.n_modes, -1)[:, 0]
     return Misfit(chi2=float(np.sum(r**2)),
                   freq_error_rms_pct=float(100 * np.sqrt(np.mean(f_err**2))) if f_err.size
                   else float("inf"),
-                  mac_mean=float(np.mean(macs)) if macs.size else 0.0, n_residuals=r.size,
-                  chi2_freq=float(np.sum(freq**2)), n_freq=measured.n_modes)
+                  mac_mean=float(np.mean(macs)) if macs is not None and macs.size else no_mac,
+                  n_residuals=r.size, chi2_freq=float(np.sum(freq**2)),
+                  n_freq=measured.n_modes)
 
 
 def residuals(model, measured, noise: Noise, C=None):
     """Fixed-length residual vector (per measured mode: frequency, then sensors), the
-    relative frequency errors and MACs of the pairs; ``(None, ...)`` if the solve fails."""
+    relative frequency errors and MACs of the pairs (None for a frequency-only test, whose
+    modes pair by frequency and whose residuals are the frequencies alone); ``(None, ...)``
+    if the solve fails."""
     try:
         disc = discretise(model)
         n_model = min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(model))
         modes = discretisation_modes(disc, n_model)
     except (GfeSolverError, ValueError, np.linalg.LinAlgError):
         return None, np.zeros(0), np.zeros(0)
+    if measured.frequency_only:
+        pairs = pair_by_frequency(measured.frequencies_hz, modes.frequencies_hz)
+        rows = np.array([t for t, _ in pairs], dtype=int)
+        cols = np.array([m for _, m in pairs], dtype=int)
+        r = np.full(measured.n_modes, 0.5 / noise.freq)
+        f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
+        r[rows] = f_err / noise.freq
+        return r, f_err, None
     if C is None:
         C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     shapes = C @ modes.shapes
@@ -223,6 +235,7 @@ class Fit:
     gain: float = 0.0          # χ² of the present effects alone minus this fit's
     threshold: float = 0.0     # the gain it needed to be significant
     notes: list = field(default_factory=list)
+    mirror_position: float | None = None   # fits as well at x -> L - x (set by diagnosis)
 
     @property
     def effect(self) -> str:
@@ -246,7 +259,7 @@ class Fit:
     def to_json(self) -> dict:
         out = {"effect": self.name, "parameters": jsonable(self.parameters),
                "uncertainty": jsonable(self.uncertainty), **self.misfit.summary(),
-               "significant": self.significant}
+               "significant": self.significant, "mirror_position": self.mirror_position}
         return out
 
 
@@ -274,7 +287,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     slots = slots_for(model, adding)
     if C is None:
         C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
-    n_res = measured.n_modes * (1 + measured.n_sensors)
+    n_res = measured.n_values
     counter = {"n": 0}
 
     def effects_of(z):

@@ -5,14 +5,22 @@ Formats (contracts, see README "Measured modes"):
 * JSON::
 
     {"sensors": {"x": [0.0125, 0.025], "dof": "w"},
-     "modes": [{"frequency": 223.4, "shape": [0.068, 0.136]}]}
+     "modes": [{"frequency": 223.4, "damping": 0.012, "shape": [0.068, 0.136]}]}
+
+  ``damping`` (the modal damping ratio ζ, 0 ≤ ζ < 1) is optional.  A test without shapes
+  leaves out ``sensors`` and every ``shape``: ``{"modes": [{"frequency": 6.57}, ...]}``.
 
 * CSV: a header row ``x,<f1>,<f2>,...`` (the first cell any label, the others the natural
   frequencies in Hz), then one row per sensor: its position x [m] and one value per mode.
   Lines starting with ``#`` are comments.  The DOF is the model's (``w`` beam, ``u`` bar).
+  The header row alone is a frequency-only test.
 * UFF (``.uff``/``.unv``): node coordinates from dataset 15 or 2411 (x along the structure),
   one dataset 55 (analysis type 2, normal modes) per mode.  ``w`` is read from the z
   component (or y when every z is zero), ``u`` from the x component.
+
+Fewer than :data:`MIN_SHAPE_SENSORS` sensors make a *frequency-only* test: shapes at one or
+two points cannot tell modes apart (the MAC of two numbers is near 1 for any pair), so the
+modes pair by frequency and only frequencies are compared.
 
 Shapes may have any scale and sign; they are kept with each mode's largest amplitude at 1 (a
 mode shape's scale means nothing, and 1e300 squared overflows).  Modes are sorted by
@@ -35,6 +43,8 @@ from .inputs import MAX_MEASURED_MODES, MAX_SENSORS, check_input_file, read_text
 from .outputs import atomic_write, check_output_path
 
 DOFS = ("w", "u")
+#: shapes at fewer sensors than this are not compared (frequency-only test)
+MIN_SHAPE_SENSORS = 3
 #: measured frequencies above this are not structural modes
 MAX_FREQUENCY_HZ = 1e8
 
@@ -52,6 +62,7 @@ class MeasuredModes:
     frequencies_hz: np.ndarray
     shapes: np.ndarray
     source: str = "measured"
+    damping: np.ndarray | None = None
 
     @property
     def n_modes(self) -> int:
@@ -62,17 +73,43 @@ class MeasuredModes:
         return len(self.x)
 
     @property
+    def frequency_only(self) -> bool:
+        """Too few sensors for shapes to tell modes apart: compared by frequency alone."""
+        return self.n_sensors < MIN_SHAPE_SENSORS
+
+    @property
+    def shape_sensors(self) -> int:
+        """Shape residuals per mode (0 for a frequency-only test)."""
+        return 0 if self.frequency_only else self.n_sensors
+
+    @property
+    def n_values(self) -> int:
+        """Measured values compared with a model: frequencies and, if used, shapes."""
+        return self.n_modes * (1 + self.shape_sensors)
+
+    def without_shapes_note(self) -> str | None:
+        """Why the shapes are not used, or None."""
+        if not self.frequency_only:
+            return None
+        what = ("no mode shapes" if self.n_sensors == 0 else
+                f"shapes at {self.n_sensors} sensor{'s' if self.n_sensors > 1 else ''} "
+                "cannot tell modes apart")
+        return (f"{what}: modes paired by frequency (nearest, one to one) and only "
+                "frequencies compared; MAC and where the model fails are unavailable")
+
+    @property
     def omega(self) -> np.ndarray:
         return 2.0 * np.pi * self.frequencies_hz
 
 
-def make_measured(x, dof, frequencies_hz, shapes, source="measured") -> MeasuredModes:
-    """Validate and build :class:`MeasuredModes` (modes sorted by frequency)."""
+def make_measured(x, dof, frequencies_hz, shapes, source="measured",
+                  damping=None) -> MeasuredModes:
+    """Validate and build :class:`MeasuredModes` (modes sorted by frequency).  ``x`` empty
+    and ``shapes`` None make a frequency-only test; ``damping`` holds ζ per mode (NaN where
+    not measured) or is None."""
     if dof not in DOFS:
         raise GfeInputError(source, "sensors.dof", f"unknown dof {dof!r} (one of w, u)")
-    x = _finite_array(x, source, "sensors.x", ndim=1)
-    if x.size == 0:
-        raise GfeInputError(source, "sensors.x", "no sensors")
+    x = _finite_array([] if x is None else x, source, "sensors.x", ndim=1)
     if x.size > MAX_SENSORS:
         raise GfeInputError(source, "sensors.x", f"{x.size} sensors is above the limit of "
                             f"{MAX_SENSORS}")
@@ -92,22 +129,38 @@ def make_measured(x, dof, frequencies_hz, shapes, source="measured") -> Measured
         i = int(np.flatnonzero(f > MAX_FREQUENCY_HZ)[0])
         raise GfeInputError(source, f"modes[{i}].frequency", f"{f[i]:g} Hz is above "
                             f"{MAX_FREQUENCY_HZ:g} Hz: not a structural mode (a typo?)")
+    if shapes is None:
+        if x.size:
+            raise GfeInputError(source, "shape", f"{x.size} sensors but no shapes")
+        shapes = np.zeros((0, f.size))
     shapes = _finite_array(shapes, source, "shape", ndim=2)
     if shapes.shape != (x.size, f.size):
         raise GfeInputError(source, "shape", f"expected {x.size} values per mode (one per "
                             f"sensor) for {f.size} modes, got array {shapes.shape}")
-    zero = np.flatnonzero(~np.any(shapes != 0, axis=0))
-    if zero.size:
-        raise GfeInputError(source, f"modes[{zero[0]}].shape", "all values are zero")
-    # shapes have any scale: each mode to a largest amplitude of 1 before any product
-    # (1e300 squared overflows, 1e-320 squared underflows)
-    shapes = shapes / np.max(np.abs(shapes), axis=0)
+    if x.size:
+        zero = np.flatnonzero(~np.any(shapes != 0, axis=0))
+        if zero.size:
+            raise GfeInputError(source, f"modes[{zero[0]}].shape", "all values are zero")
+        # shapes have any scale: each mode to a largest amplitude of 1 before any product
+        # (1e300 squared overflows, 1e-320 squared underflows)
+        shapes = shapes / np.max(np.abs(shapes), axis=0)
+    if damping is not None:
+        damping = np.asarray(damping, dtype=float)
+        if damping.shape != f.shape:
+            raise GfeInputError(source, "damping", f"expected one value per mode ({f.size}), "
+                                f"got {damping.size}")
+        bad = np.flatnonzero(~np.isnan(damping) & ~((damping >= 0) & (damping < 1)))
+        if bad.size:
+            raise GfeInputError(source, f"modes[{bad[0]}].damping", "must be a damping ratio "
+                                f"in [0, 1), got {damping[bad[0]]:g}")
     order = np.argsort(f, kind="stable")
     f, shapes = f[order], shapes[:, order]
+    damping = None if damping is None else damping[order]
     dup = np.flatnonzero(np.diff(f) == 0)
     if dup.size:
         raise GfeInputError(source, "frequency", f"frequency {f[dup[0]]:g} Hz appears twice")
-    return MeasuredModes(x=x, dof=dof, frequencies_hz=f, shapes=shapes, source=source)
+    return MeasuredModes(x=x, dof=dof, frequencies_hz=f, shapes=shapes, source=source,
+                         damping=damping)
 
 
 def _finite_array(values, source, field, ndim):
@@ -157,35 +210,57 @@ def _read_json(path: Path) -> MeasuredModes:
     for key in data:
         if key not in ("sensors", "modes"):
             raise GfeInputError(where, key, "unknown key (expected sensors, modes)")
-    sensors = data.get("sensors")
-    if not isinstance(sensors, dict) or "x" not in sensors:
-        raise GfeInputError(where, "sensors", "missing or without x (sensor positions in m)")
-    for key in sensors:
-        if key not in ("x", "dof"):
-            raise GfeInputError(where, f"sensors.{key}", "unknown key (expected x, dof)")
     modes = data.get("modes")
     if not isinstance(modes, list) or not modes:
         raise GfeInputError(where, "modes", "missing or empty (a list of modes)")
-    freqs, shapes = [], []
-    n_sensors = len(sensors["x"]) if isinstance(sensors["x"], list) else -1
+    with_shape = [isinstance(m, dict) and "shape" in m for m in modes]
+    sensors = data.get("sensors")
+    if any(with_shape) or sensors is not None:
+        if not isinstance(sensors, dict) or "x" not in sensors:
+            raise GfeInputError(where, "sensors", "missing or without x (sensor positions "
+                                "in m); leave out sensors and every shape for a "
+                                "frequency-only test")
+        for key in sensors:
+            if key not in ("x", "dof"):
+                raise GfeInputError(where, f"sensors.{key}", "unknown key (expected x, dof)")
+    n_sensors = (len(sensors["x"]) if isinstance(sensors["x"], list) else -1) if sensors \
+        else 0
+    shaped = n_sensors != 0
+    freqs, shapes, damping = [], [], []
     for i, mode in enumerate(modes):
-        if not isinstance(mode, dict) or "frequency" not in mode or "shape" not in mode:
-            raise GfeInputError(where, f"modes[{i}]", "needs frequency and shape")
+        if not isinstance(mode, dict) or "frequency" not in mode:
+            raise GfeInputError(where, f"modes[{i}]", "needs a frequency")
         for key in mode:
-            if key not in ("frequency", "shape"):
-                raise GfeInputError(where, f"modes[{i}].{key}", "unknown key")
+            if key not in ("frequency", "damping", "shape"):
+                raise GfeInputError(where, f"modes[{i}].{key}", "unknown key (expected "
+                                    "frequency, damping, shape)")
         if not _is_number(mode["frequency"]):
             raise GfeInputError(where, f"modes[{i}].frequency",
                                 f"must be a number, got {mode['frequency']!r}")
-        if not isinstance(mode["shape"], list) or not all(_is_number(v) for v in mode["shape"]):
-            raise GfeInputError(where, f"modes[{i}].shape", "must be a list of numbers")
-        if len(mode["shape"]) != n_sensors:
-            raise GfeInputError(where, f"modes[{i}].shape", f"has {len(mode['shape'])} values "
-                                f"but there are {n_sensors} sensors")
+        if "damping" in mode and not _is_number(mode["damping"]):
+            raise GfeInputError(where, f"modes[{i}].damping",
+                                f"must be a number, got {mode['damping']!r}")
+        if shaped and "shape" not in mode:
+            raise GfeInputError(where, f"modes[{i}]", "has no shape while there are sensors "
+                                "(give every mode a shape, or none and no sensors)")
+        if not shaped and "shape" in mode:
+            raise GfeInputError(where, f"modes[{i}].shape", "given but there are no sensors")
+        if shaped:
+            if not isinstance(mode["shape"], list) or not all(_is_number(v)
+                                                              for v in mode["shape"]):
+                raise GfeInputError(where, f"modes[{i}].shape", "must be a list of numbers")
+            if len(mode["shape"]) != n_sensors:
+                raise GfeInputError(where, f"modes[{i}].shape", f"has {len(mode['shape'])} "
+                                    f"values but there are {n_sensors} sensors")
+            shapes.append(mode["shape"])
         freqs.append(mode["frequency"])
-        shapes.append(mode["shape"])
+        damping.append(mode.get("damping", np.nan))
+    damping = None if all(np.isnan(d) for d in damping) else damping
+    if not shaped:
+        return make_measured(None, (sensors or {}).get("dof", "w"), freqs, None, where,
+                             damping)
     return make_measured(sensors["x"], sensors.get("dof", "w"), freqs,
-                         np.array(shapes, dtype=float).T, where)
+                         np.array(shapes, dtype=float).T, where, damping)
 
 
 def _is_number(v):
@@ -197,8 +272,8 @@ def _read_csv(path: Path, dof: str) -> MeasuredModes:
     lines = [ln for ln in read_text(path, "measured").splitlines()
              if ln.strip() and not ln.lstrip().startswith("#")]
     rows = list(csv.reader(lines))
-    if len(rows) < 2:
-        raise GfeInputError(where, None, "needs a header row of frequencies and sensor rows")
+    if not rows:
+        raise GfeInputError(where, None, "needs a header row of frequencies (and sensor rows)")
     header = rows[0]
     try:
         freqs = [float(v) for v in header[1:]]
@@ -216,7 +291,7 @@ def _read_csv(path: Path, dof: str) -> MeasuredModes:
             raise GfeInputError(where, f"row {i}", f"non-numeric cell in {row}") from None
         x.append(vals[0])
         shapes.append(vals[1:])
-    return make_measured(x, dof, freqs, np.array(shapes), where)
+    return make_measured(x, dof, freqs, np.array(shapes) if x else None, where)
 
 
 def _check_uff_complete(path: Path) -> None:
@@ -285,10 +360,18 @@ def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
 
 
 def measured_to_dict(m: MeasuredModes) -> dict:
-    """The JSON form of measured modes."""
-    return {"sensors": {"x": [float(v) for v in m.x], "dof": m.dof},
-            "modes": [{"frequency": float(f), "shape": [float(v) for v in m.shapes[:, j]]}
-                      for j, f in enumerate(m.frequencies_hz)]}
+    """The JSON form of measured modes (``damping`` where measured, no ``sensors`` and no
+    ``shape`` for a test without sensors)."""
+    modes = []
+    for j, f in enumerate(m.frequencies_hz):
+        mode = {"frequency": float(f)}
+        if m.damping is not None and np.isfinite(m.damping[j]):
+            mode["damping"] = float(m.damping[j])
+        if m.n_sensors:
+            mode["shape"] = [float(v) for v in m.shapes[:, j]]
+        modes.append(mode)
+    out = {"sensors": {"x": [float(v) for v in m.x], "dof": m.dof}} if m.n_sensors else {}
+    return {**out, "modes": modes}
 
 
 def save_measured(m: MeasuredModes, path, *, force: bool = False, protect=()) -> None:
@@ -308,6 +391,9 @@ def save_measured(m: MeasuredModes, path, *, force: bool = False, protect=()) ->
                     w.writerow([repr(float(x))] + [repr(float(v)) for v in m.shapes[i]])
         atomic_write(path, write)
     elif suffix in (".uff", ".unv"):
+        if not m.n_sensors:
+            raise GfeInputError(str(path), None, "modes without shapes cannot be written as "
+                                "UFF dataset 55 (it holds shapes at nodes): use .json or .csv")
         atomic_write(path, lambda p: _write_uff(m, p))
     else:
         raise GfeInputError(str(path), None, f"unknown measured-data format {suffix!r}")
@@ -344,11 +430,10 @@ def on_model(measured: MeasuredModes, model) -> tuple[MeasuredModes, list[str]]:
     """The measured modes without sensors on an end whose support holds the measured DOF
     still (they read only noise, and would point the localisation at the support), and a
     note saying which were dropped."""
-    from .effects.base import FIXED_TRANSLATION
+    from .effects.base import translation_held
 
     tol = 1e-6 * model.length
-    held = [x for x, support in ((0.0, model.supports[0]), (model.length, model.supports[1]))
-            if support in FIXED_TRANSLATION]
+    held = [x for end, x in enumerate((0.0, model.length)) if translation_held(model, end)]
     drop = np.zeros(measured.n_sensors, dtype=bool)
     for x in held:
         drop |= np.abs(measured.x - x) <= tol
@@ -358,7 +443,7 @@ def on_model(measured: MeasuredModes, model) -> tuple[MeasuredModes, list[str]]:
         raise GfeInputError(measured.source, "sensors.x", "every sensor sits on a support "
                             "that holds the structure still: nothing to compare")
     kept = make_measured(measured.x[~drop], measured.dof, measured.frequencies_hz,
-                         measured.shapes[~drop], measured.source)
+                         measured.shapes[~drop], measured.source, measured.damping)
     where = ", ".join(f"x = {x:g} m" for x in measured.x[drop])
     return kept, [f"sensor{'s' if drop.sum() > 1 else ''} at {where} on a support that holds "
                   "the structure still: left out (it reads only noise)"]

@@ -15,6 +15,8 @@ from .outputs import atomic_write
 def compare_figures(result, model) -> dict:
     """MAC matrix, paired frequencies and the localisation of a comparison."""
     pairs = [(p.test_mode - 1, p.model_mode - 1) for p in result.pairs]
+    if result.mac_matrix is None:  # frequency-only test: no MAC, no localisation
+        return {"frequencies.png": plots.paired_frequencies(result.pairs)}
     return {
         "mac.png": plots.mac_matrix(result.mac_matrix, pairs),
         "frequencies.png": plots.paired_frequencies(result.pairs),

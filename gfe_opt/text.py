@@ -24,8 +24,14 @@ VERDICT_WORDS = {
 def misfit_line(m, label: str = "") -> str:
     """``frequency error 5.591 % rms, mean MAC 0.9919, χ²/n 663.6``."""
     head = f"{label}: " if label else ""
-    return (f"{head}frequency error {m.freq_error_rms_pct:.3f} % rms, mean MAC "
-            f"{m.mac_mean:.4f}, χ²/n {_ratio(m.chi2_per_residual)}")
+    mac = "" if m.mac_mean is None else f", mean MAC {m.mac_mean:.4f}"
+    return (f"{head}frequency error {m.freq_error_rms_pct:.3f} % rms{mac}, χ²/n "
+            f"{_ratio(m.chi2_per_residual)}")
+
+
+def _mac(value, width: int, digits: int) -> str:
+    """A MAC in a table column; '—' where there is none (paired by frequency)."""
+    return f"{'—':>{width}}" if value is None else f"{value:{width}.{digits}f}"
 
 
 def _ratio(value: float) -> str:
@@ -39,13 +45,16 @@ def format_comparison(result, length: float) -> str:
     lines = [f"{'mode':>4}  {'f_test [Hz]':>12}  {'f_model [Hz]':>12}  {'Δf %':>8}  {'MAC':>6}"]
     for p in result.pairs:
         lines.append(f"{p.test_mode:>4}  {p.test_hz:12.2f}  {p.model_hz:12.2f}  "
-                     f"{p.error_pct:+8.2f}  {p.mac:6.3f}")
+                     f"{p.error_pct:+8.2f}  {_mac(p.mac, 6, 3)}")
     for t in result.unpaired_test_modes:
         lines.append(f"{t + 1:>4}  (no model mode with MAC >= threshold)")
-    lines.append(f"frequency error (rms) {result.freq_error_rms_pct:.2f} %, "
-                 f"mean MAC {result.mac_mean:.3f}")
+    mac = "" if result.mac_mean is None else f", mean MAC {result.mac_mean:.3f}"
+    lines.append(f"frequency error (rms) {result.freq_error_rms_pct:.2f} %{mac}")
     places = result.failure_places()
     lines.append("")
+    if result.residual is None:
+        lines.extend(f"note: {n}" for n in result.notes)
+        return "\n".join(lines)
     if not places:
         lines.append("no residual force: the model reproduces the measured shapes")
         lines.extend(f"note: {n}" for n in result.notes)
@@ -77,7 +86,7 @@ def format_diagnosis(result, model) -> str:
               f"{'Δχ²':>9} {'needed':>8} {'size σ':>7}  significant"]
     for i, f in enumerate(result.fits, 1):
         lines.append(f"{i:>4}  {f.name:<18} {_ratio(f.misfit.chi2_per_residual):>8} "
-                     f"{f.misfit.freq_error_rms_pct:8.3f} {f.misfit.mac_mean:7.4f} "
+                     f"{f.misfit.freq_error_rms_pct:8.3f} {_mac(f.misfit.mac_mean, 7, 4)} "
                      f"{_ratio(f.gain):>9} {_ratio(f.threshold):>8} "
                      f"{min(f.size_sigmas, 999):7.1f}  {'yes' if f.significant else 'no'}")
     if result.failed:
@@ -93,9 +102,10 @@ def format_diagnosis(result, model) -> str:
                      f"{_ratio(best.misfit.chi2_per_residual)}")
         lines.append(f"  add it: gfe-opt update MODEL MEASURED --add {best.name}")
     elif result.verdict == "unexplained":
-        lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 fits to the noise); where "
-                     "the model fails: " + ", ".join(f"x = {x:.3f} m" for x, _ in
-                                                     result.localisation))
+        where = ("where the model fails: " + ", ".join(f"x = {x:.3f} m" for x, _ in
+                                                       result.localisation)
+                 if result.localisation else "where it fails is unknown without mode shapes")
+        lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 fits to the noise); {where}")
     for word in result.realisation:
         lines.append(f"the generic-element update (nodal k_i): {word}")
     lines += [f"note: {n}" for n in result.notes]

@@ -101,7 +101,7 @@ from scipy.sparse.linalg import splu, spsolve_triangular
 from . import elements as el
 from .assembly import Discretisation, discretise
 from .correlation import DEFAULT_SHAPE_NOISE, expand_modes
-from .errors import GfeSolverError
+from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, sensor_matrix
 from .model import Model
 from .parameterisation import Parameterisation, parameterisation_for
@@ -729,6 +729,9 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
         raise ValueError("mass parameters are updated with method='expand' only")
     if weighting == "energy" and method != "expand":
         raise ValueError("weighting='energy' is available with method='expand' only")
+    if measured.frequency_only and full_shapes is None:
+        raise GfeInputError(measured.source, "sensors", "the generic-element update needs "
+                            "mode shapes at 3 or more sensors: " + measured.without_shapes_note())
     disc, par, regularisation = _setup(model, parameterisation, regularisation,
                                        full_shapes is not None)
     start = time.perf_counter()

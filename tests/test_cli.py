@@ -38,7 +38,8 @@ def test_compare_json_contract(files, capsys):
     model, measured, _ = files
     assert main(["compare", str(model), str(measured), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert set(data) == {"pairs", "freq_error_rms_pct", "mac_mean", "localisation"}
+    assert set(data) == {"pairs", "freq_error_rms_pct", "mac_mean", "localisation", "pairing"}
+    assert data["pairing"] == "mac"
     assert set(data["pairs"][0]) == {"test_mode", "model_mode", "test_hz", "model_hz",
                                      "error_pct", "mac"}
     assert len(data["pairs"]) == 4 and data["freq_error_rms_pct"] > 1.0
@@ -84,14 +85,16 @@ def test_diagnose_json_contract(files, capsys):
                  "--candidates", "material,crack"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert set(data) == {"verdict", "baseline", "noise", "effects", "failed", "skipped",
-                         "realisation", "notes"}
+                         "indistinguishable", "realisation", "notes"}
+    assert data["indistinguishable"] == []
     assert data["verdict"] == "effect_found"
     assert set(data["baseline"]) == {"freq_error_rms_pct", "mac_mean", "chi2_per_residual"}
     assert set(data["noise"]) == {"freq", "shape", "given", "implied_freq", "implied_shape"}
     assert [e["effect"] for e in data["effects"]][0] == "crack"
     for entry in data["effects"]:
         assert set(entry) == {"effect", "parameters", "uncertainty", "freq_error_rms_pct",
-                              "mac_mean", "chi2_per_residual", "significant"}
+                              "mac_mean", "chi2_per_residual", "significant",
+                              "mirror_position"}
         assert set(entry["uncertainty"]) <= set(entry["parameters"])
     first = data["effects"][0]
     assert first["significant"] and abs(first["parameters"]["position"] - 0.4) < 0.015

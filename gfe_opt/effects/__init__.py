@@ -81,10 +81,11 @@ def _register_builtins():
         shear,
         stiffness_profile,
         support_spring,
+        support_translation,
     )
 
     for module in (material, crack, section_loss, shear, axial_load, foundation,
-                   support_spring, point_spring, point_mass, stiffness_profile, mass_profile):
+                   support_spring, support_translation, point_spring, point_mass, stiffness_profile, mass_profile):
         register_effect(module.EFFECT)
 
 

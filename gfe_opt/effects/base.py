@@ -157,6 +157,31 @@ FIXED_TRANSLATION = ("pinned", "clamped", "fixed")
 FREE_MOMENT = ("pinned", "free")
 
 
+def translation_held(model, end: int) -> bool:
+    """Whether the support at ``end`` (0 left, 1 right) holds the translation still, with
+    the model's effects (a ``support_translation`` lets it give)."""
+    if model.supports[end] not in FIXED_TRANSLATION:
+        return False
+    side = ("left", "right")[end]
+    for e in model.effects:
+        if side in effect_sides(e.parameters) and \
+                getattr(_registry_type(e.name), "releases_translation", False):
+            return False
+    return True
+
+
+def effect_sides(params) -> tuple:
+    """The ends a ``side`` parameter names."""
+    side = params.get("side")
+    return ("left", "right") if side == "both" else (side,) if side else ()
+
+
+def _registry_type(name):
+    from . import effect_type
+
+    return effect_type(name)
+
+
 def check_not_on_support(model, params, where, prefix, name, supports, why):
     """A point effect on an end whose support makes it meaningless is an error."""
     if "position" not in params:
