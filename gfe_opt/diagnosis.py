@@ -64,6 +64,7 @@ from .correlation import check_model_size, check_units, compare
 from .effects import candidate_names, effect_type
 from .errors import GfeInputError, GfeSolverError
 from .fitting import (
+    ALIKE_CHI2,
     DEFAULT_FREQ_NOISE,
     DEFAULT_SHAPE_NOISE,
     Fit,
@@ -250,13 +251,15 @@ def _candidates(model: Model, candidates) -> list[str]:
 # -------------------------------------------------------------------------------------------
 
 
-def _fit_candidate(model, measured, name, noise, hint, given=None, extra=()):
+def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), seeds=()):
     """Fit one candidate from each of its starting points, keep the best.  ``given`` holds
     parameters the user fixed as starting values; ``extra`` effects are added first
-    (lookahead pairs)."""
+    (lookahead pairs); from frequencies alone IPOPT then runs from every start, ``seeds``
+    (the candidate's own fit alone) and profile starts included: two effects that trade
+    against each other (a soft clamp, a tip mass) are found only by moving both."""
     kind = effect_type(name)
     groups = {}  # starts that share their fixed parameters: one fit, the best start wins
-    for start in kind.starts(model, hint):
+    for start in [*kind.starts(model, hint), *seeds]:
         start = {**start, **(given or {})}
         key = repr({k: start.get(k) for k in kind.fixed_keys()})
         if start not in groups.setdefault(key, []):
@@ -264,7 +267,8 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=()):
     best = None
     for starts in groups.values():
         fit = fit_effects(model, measured, [*extra, Effect(name, starts[0])], noise=noise,
-                          name=name, alternatives=starts[1:])
+                          name=name, alternatives=starts[1:],
+                          multistart=True if extra and measured.frequency_only else "auto")
         if best is None or fit.misfit.chi2 < best.misfit.chi2:
             best = fit
     if extra:
@@ -490,6 +494,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                 notes.append(f"{best.name} with a further {pair.name} brings the misfit to the "
                              f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}): add them one "
                              "at a time")
+                notes += equivalent_notes(pair, measured)
                 if profile is not None:
                     profile.significant = False  # named effects win where they explain
             elif profile is not None and profile.significant and explains(profile):
@@ -593,7 +598,9 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
               and not getattr(effect_type(f.name), "fallback", False)]
     seconds = ([best.name] if effect_type(best.name).local else []) + [f.name for f in others]
     first = Effect(best.name, best.parameters)
-    jobs = [("candidate", (model, measured, name, noise, hint, None, (first,)))
+    alone = {f.name: f.parameters for f in others}
+    jobs = [("candidate", (model, measured, name, noise, hint, None, (first,),
+                           [alone[name]] if name in alone else []))
             for name in seconds]
     pairs = [p for p in _run_jobs(jobs, None, seconds) if p.success and explains(p)]
     return min(pairs, key=sel.penalised, default=None)
@@ -613,10 +620,6 @@ def _generic_update(model, measured, noise):
         return None, None
     band = profile_band(disc, measured, result, noise) if result.ok else None
     return result, band
-
-
-#: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
-ALIKE_CHI2 = quantile(1, 0.05)
 
 
 def _alike(ranked, sel) -> list:
@@ -640,7 +643,16 @@ def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
     mirror = _mirror(best, measured, noise, C, sel)
     if mirror is not None:
         notes.append(mirror)
+    notes += equivalent_notes(best, measured)
     return notes
+
+
+def equivalent_notes(fit, measured) -> list[str]:
+    """Sentences for other parameter sets that fit the data as well as ``fit``."""
+    what = "the frequencies" if measured.frequency_only else "the data"
+    return [f"{what} fit as well with " + "; ".join(
+        f"{e.name}: {effect_type(e.name).describe(e.parameters)}" for e in effects)
+        + f" — {what} cannot tell these apart" for effects in fit.equivalent]
 
 
 def _mirror(fit, measured, noise, C, sel) -> str | None:
@@ -844,7 +856,7 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
         raise GfeSolverError(f"IPOPT did not fit the effects ({fit.status})")
     return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit,
                          added=list(range(len(model.effects), len(fit.effects))),
-                         notes=dropped)
+                         notes=[*dropped, *equivalent_notes(fit, measured)])
 
 
 def _default_fixed(kind, model):

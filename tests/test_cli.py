@@ -94,7 +94,7 @@ def test_diagnose_json_contract(files, capsys):
     for entry in data["effects"]:
         assert set(entry) == {"effect", "parameters", "uncertainty", "freq_error_rms_pct",
                               "mac_mean", "chi2_per_residual", "significant",
-                              "mirror_position"}
+                              "mirror_position", "equivalent"}
         assert set(entry["uncertainty"]) <= set(entry["parameters"])
     first = data["effects"][0]
     assert first["significant"] and abs(first["parameters"]["position"] - 0.4) < 0.015

@@ -85,7 +85,8 @@ def _register_builtins():
     )
 
     for module in (material, crack, section_loss, shear, axial_load, foundation,
-                   support_spring, support_translation, point_spring, point_mass, stiffness_profile, mass_profile):
+                   support_spring, support_translation, point_spring, point_mass,
+                   stiffness_profile, mass_profile):
         register_effect(module.EFFECT)
 
 

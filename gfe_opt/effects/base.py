@@ -134,9 +134,13 @@ class Variable:
         return float(value / s)
 
 
-def position_variable() -> Variable:
-    """x / length in [0, 1], grid of 19 places: the position of a local effect."""
-    return Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
+def position_variable(model=None) -> Variable:
+    """x / length in [0, 1], grid of 19 places from 0.05 to 0.95: the position of a local
+    effect; with ``model``, also each end whose support lets it move (a mass at the tip of
+    a cantilever)."""
+    ends = () if model is None else tuple(
+        float(end) for end in (0, 1) if model.supports[end] not in FIXED_TRANSLATION)
+    return Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)) + ends,
                     scale=lambda model: model.length)
 
 

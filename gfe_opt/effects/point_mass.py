@@ -31,7 +31,7 @@ class PointMass(EffectType):
         build.add_point_mass(params["position"], params["mass"])
 
     def variables(self, model, fixed):
-        return [position_variable(),
+        return [position_variable(model),
                 Variable("mass", 1e-4, 3.0, (0.05, 0.2, 0.5),
                          scale=lambda m: m.rho * m.area * m.length)]
 

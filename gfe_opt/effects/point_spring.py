@@ -39,7 +39,7 @@ class PointSpring(EffectType):
         build.add_point_stiffness(params["position"], params["stiffness"])
 
     def variables(self, model, fixed):
-        return [position_variable(),
+        return [position_variable(model),
                 Variable("stiffness", -3.0, 5.0, (0.0, 1.0, 2.0), log=True, scale=_scale)]
 
     def starts(self, model, hint):
