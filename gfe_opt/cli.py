@@ -19,10 +19,17 @@ from .effects import EFFECTS
 from .errors import GfeInputError, GfeSolverError
 from .fitting import DEFAULT_FREQ_NOISE
 from .fitting import DEFAULT_SHAPE_NOISE as DEFAULT_FIT_SHAPE_NOISE
+from .identify import FRF_FORMS
 from .measured import load_measured
 from .model import load_model
 from .outputs import check_distinct, check_output_folder, check_output_path
-from .text import format_comparison, format_diagnosis, format_update, terminal_progress
+from .text import (
+    format_comparison,
+    format_diagnosis,
+    format_identification,
+    format_update,
+    terminal_progress,
+)
 
 
 def _fraction(text: str) -> float:
@@ -115,6 +122,26 @@ def build_parser() -> argparse.ArgumentParser:
     o.add_argument("--out", required=True, help="output file (.uff, .unv, .json or .csv)")
     o.add_argument("--modes", type=int, default=5, help="number of modes (default 5)")
     o.add_argument("--force", action="store_true", help="overwrite an existing --out file")
+
+    i = sub.add_parser("identify", help="identify modes (frequencies, damping, shapes) from "
+                       "measured FRFs (UFF 58 or CSV)")
+    i.add_argument("frf", nargs="+", help="FRF files (.uff/.unv with dataset 58 and node "
+                   "coordinates, or .csv: a header of positions, then frequency rows)")
+    i.add_argument("--out", required=True, help="measured modes to write (.json with damping, "
+                   ".csv or .uff)")
+    i.add_argument("--band", metavar="LOW:HIGH", default=None,
+                   help="frequency band in Hz (default: the measured range without its first "
+                        "and last 2 %%)")
+    i.add_argument("--modes", type=int, default=None,
+                   help="number of modes to keep, the most stable (default: every mode stable "
+                        "over a fifth of the model orders)")
+    i.add_argument("--order", type=int, default=60,
+                   help="highest LSCF model order (default %(default)s)")
+    i.add_argument("--frf-form", choices=FRF_FORMS, default=None,
+                   help="what the CSV values are (default accelerance; UFF files say it)")
+    i.add_argument("--json", action="store_true", help="print the modes as JSON")
+    i.add_argument("--plot", metavar="DIR", help="write the stabilisation chart into DIR")
+    i.add_argument("--force", action="store_true", help="overwrite existing output files")
 
     d = sub.add_parser("demo", help="the whole story on a synthetic cracked beam")
     d.add_argument("--out", default="gfe-opt-demo",
@@ -306,6 +333,50 @@ def cmd_update(args) -> int:
     return 0
 
 
+def _band(text):
+    """``LOW:HIGH`` in Hz."""
+    if text is None:
+        return None
+    low, sep, high = text.partition(":")
+    try:
+        band = (float(low), float(high))
+    except ValueError:
+        raise GfeInputError("--band", text, "must be LOW:HIGH in Hz, e.g. 10:1000") from None
+    if not sep or not all(np.isfinite(band)) or not 0 <= band[0] < band[1]:
+        raise GfeInputError("--band", text, "must be LOW:HIGH in Hz with 0 <= LOW < HIGH")
+    return band
+
+
+def cmd_identify(args) -> int:
+    from .identify import identify, load_frfs
+    from .measured import save_measured
+
+    band = _band(args.band)
+    if args.modes is not None and args.modes < 1:
+        raise GfeInputError("--modes", None, f"must be >= 1, got {args.modes}")
+    if not 4 <= args.order <= 400:
+        raise GfeInputError("--order", None, f"must lie in [4, 400], got {args.order}")
+    check_output_path(args.out, args.force, args.frf, kind="modes")
+    _check_outputs(args, ("stabilisation.png",))
+    frfs = load_frfs(args.frf, args.frf_form)
+    result = identify(frfs, band=band, modes=args.modes, order=args.order)
+    save_measured(result.measured, args.out, force=args.force, protect=args.frf)
+    if args.json:
+        print(json.dumps(result.to_json(), indent=1))
+    else:
+        print(format_identification(result))
+        print(f"modes written to {args.out}")
+    if args.plot:
+        from . import plots
+        from .report import save_figures
+
+        paths = save_figures({"stabilisation.png": _figures(plots.stabilisation, result)},
+                             args.plot)
+        if not args.json:
+            print(f"figures: {', '.join(str(p) for p in paths)}")
+    return 0
+
+
 def cmd_demo(args) -> int:
     from .demo import run_demo
 
@@ -323,7 +394,8 @@ def main(argv=None) -> int:
         args.argv = argv
         with np.errstate(all="ignore"):
             return {"compare": cmd_compare, "diagnose": cmd_diagnose, "update": cmd_update,
-                    "modes": cmd_modes, "demo": cmd_demo}[args.command](args)
+                    "modes": cmd_modes, "identify": cmd_identify,
+                    "demo": cmd_demo}[args.command](args)
     except GfeInputError as exc:
         print(f"gfe-opt: error: {_one_line(exc)}", file=sys.stderr)
         return 2

@@ -162,6 +162,8 @@ class Diagnosis:
     seconds: float
     localisation: list = field(default_factory=list)
     alike: list = field(default_factory=list)         # effects the data cannot tell apart
+    suggested: list = field(default_factory=list)     # effect names to add (update --add)
+    together: Fit | None = None                       # the suggested pair's fit
     realisation: list = field(default_factory=list)   # the generic update in words
     nodal: list = field(default_factory=list)         # Realisation per node
     generic_update: object = None                     # the UpdateResult they come from
@@ -189,6 +191,12 @@ class Diagnosis:
                            for f in self.failed],
                 "skipped": [{"effect": name, "reason": reason} for name, reason in self.skipped],
                 "indistinguishable": [f.name for f in self.alike],
+                "suggested": list(self.suggested),
+                "together": None if self.together is None else {
+                    "effects": [{"effect": e.name, "parameters": jsonable(e.parameters),
+                                 "uncertainty": jsonable(s)}
+                                for e, s in zip(self.together.effects, self.together.sigma)],
+                    **self.together.misfit.summary()},
                 "realisation": list(self.realisation),
                 "notes": list(self.notes)}
 
@@ -430,6 +438,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             continue  # present: re-estimated in every fit
         if any(e.name in kind.redundant_with for e in model.effects):
             continue  # held by an effect present (E with a stiffness profile)
+        if not kind.starts(model, 0.5):
+            continue  # nowhere to put it (a support that gives on a free-free beam)
         try:
             check_enough_modes(measured, [*model.effects, Effect(name, {})])
         except GfeInputError as exc:
@@ -470,6 +480,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         """Brings the misfit to the noise: the stated one, or with no noise given, residuals
         that look like noise (uncorrelated from sensor to sensor, frequencies within a
         test's precision)."""
+        if fit.misfit.freq_error_rms_pct > ref_misfit.freq_error_rms_pct + 200 * noise.freq:
+            return False  # never propose what raises the frequency error beyond the noise
         if fits_noise(fit.misfit, fit.n_params):
             return True
         if noise.given:
@@ -478,7 +490,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                  < WHITE_NOISE_CORRELATION)
         return white and fit.misfit.chi2_freq / max(fit.misfit.n_freq, 1) <= FREQ_NOISE_LIMIT**2
 
-    partial = None
+    partial = together = None
+    suggested = []
     if best is not None and not explains(best) or best is None and not fits_noise(
             ref_misfit, ref_params):
         profile = (_fallback(model, measured, noise, fallback_names, sel, band, progress)
@@ -492,8 +505,9 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             pair = _lookahead(model, measured, noise, best, fits, hint, explains, sel)
             if pair is not None:
                 notes.append(f"{best.name} with a further {pair.name} brings the misfit to the "
-                             f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}): add them one "
-                             "at a time")
+                             f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}; frequency error "
+                             f"{pair.misfit.freq_error_rms_pct:.3g} %): add them together")
+                suggested, together = [best.name, pair.name], pair
                 notes += equivalent_notes(pair, measured)
                 if profile is not None:
                     profile.significant = False  # named effects win where they explain
@@ -533,6 +547,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     estimate = _noise_estimate(model, measured, noise, [*ranked, reference], C, ref_misfit,
                                sel.floor)
     verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate)
+    if verdict == "effect_found" and not suggested:
+        suggested = [ranked[0].name]
     alike = _alike(ranked, sel) if verdict == "effect_found" else []
     if verdict == "effect_found":
         notes += _ambiguities(ranked[0], alike, measured, noise, C, sel)
@@ -545,6 +561,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         notes.append("not tried: " + "; ".join(f"{n} ({r})" for n, r in skipped))
     return Diagnosis(baseline=baseline, reference=reference, fits=ranked, failed=failed,
                      skipped=skipped, verdict=verdict, noise=estimate, alike=alike,
+                     suggested=suggested if verdict == "effect_found" else [],
+                     together=together if verdict == "effect_found" else None,
                      seconds=time.perf_counter() - start, localisation=places,
                      realisation=_words_for_verdict(words or [], verdict),
                      nodal=nodal or [], generic_update=generic, profile_band=band,

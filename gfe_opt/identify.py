@@ -71,17 +71,15 @@ class Identification:
     order: int
     stable: list          # per order: stable pole frequencies [Hz]
     clusters: list        # (frequency, persistence) of every cluster
+    persistence: np.ndarray   # per mode kept: share of the orders where it is stable
+    fit_error: float      # rms |H_fit - H| / rms |H| over the band
     notes: list
 
     def to_json(self) -> dict:
-        """The measured-modes JSON contract with ``damping`` per mode."""
-        data = {"sensors": {"x": [float(v) for v in self.measured.x],
-                            "dof": self.measured.dof},
-                "modes": [{"frequency": float(f), "damping": float(z),
-                           "shape": [float(v) for v in self.measured.shapes[:, j]]}
-                          for j, (f, z) in enumerate(zip(self.measured.frequencies_hz,
-                                                         self.damping))]}
-        return data
+        """The measured-modes JSON contract (``damping`` per mode)."""
+        from .measured import measured_to_dict
+
+        return measured_to_dict(self.measured)
 
 
 # -------------------------------------------------------------------------------------------
@@ -245,11 +243,13 @@ def identify(frfs: FRFs, *, band=None, modes: int | None = None, order: int = 60
     if frfs.frf.shape[0] < 1 or np.sum((freq >= lower) & (freq <= upper)) < 4 * order:
         raise GfeInputError("--band", None, "too few frequency lines in the band for model "
                             f"order {order}")
+    notes = []
+    frf, freq = _on_fft_grid(frfs.frf, freq, notes)
     quiet = io.StringIO()
     with warnings.catch_warnings(), contextlib.redirect_stderr(quiet):
         warnings.simplefilter("ignore")
         try:
-            model = EMA.Model(frf=frfs.frf, freq=freq, lower=lower, upper=upper,
+            model = EMA.Model(frf=frf, freq=freq, lower=lower, upper=upper,
                               pol_order_high=order, frf_form=frfs.form,
                               driving_point=frfs.driving_point)
             model.get_poles(method="lscf", show_progress=False)
@@ -262,35 +262,70 @@ def identify(frfs: FRFs, *, band=None, modes: int | None = None, order: int = 60
         (fn >= lower) & (fn <= upper)
     stable = [fn[:, k][stable_mask[:, k]] for k in range(fn.shape[1])]
     clusters = _clusters(stable, fn.shape[1])
+    members = _clusters(stable, fn.shape[1], members=True)
     keep = [c for c in clusters if c[1] >= MIN_PERSISTENCE]
-    notes = []
     if modes is not None:
         if len(clusters) < modes:
             notes.append(f"{modes} modes asked for, {len(clusters)} found stable in the band")
         keep = sorted(sorted(clusters, key=lambda c: -c[1])[:modes])
     if not keep:
         raise GfeSolverError("no stable pole in the band: widen --band, or check the FRFs")
-    approx = [c[0] for c in keep]
+    chosen = [_typical_pole(members[clusters.index(c)], fn, xi, stable_mask) for c in keep]
+    model.pole_ind = np.array([(k, _pole_index(model.all_poles[k], fn[r, k], xi[r, k]))
+                               for r, k in chosen], dtype=int)
+    model.nat_freq = np.array([fn[r, k] for r, k in chosen])
+    model.nat_xi = np.array([xi[r, k] for r, k in chosen])
     with warnings.catch_warnings(), contextlib.redirect_stderr(quiet):
         warnings.simplefilter("ignore")
         try:
-            model.select_closest_poles(approx, f_window=max(1.0, 0.02 * approx[0]))
-            _, constants = model.get_constants(whose_poles="own")
+            H, constants = model.get_constants(whose_poles="own")
         except (ValueError, IndexError, np.linalg.LinAlgError) as exc:
             raise GfeSolverError(f"LSFD failed: {exc}") from None
     nat_freq = np.asarray(model.nat_freq, float)
     damping = np.asarray(model.nat_xi, float)
+    if np.any(~np.isfinite(nat_freq)) or np.any(nat_freq <= 0):
+        raise GfeSolverError("LSFD returned no usable poles: widen --band or lower --order")
     shapes = _real_shapes(np.asarray(constants))
-    measured = make_measured(frfs.x, dof, nat_freq, shapes, frfs.source)
-    order_of = np.argsort(nat_freq, kind="stable")
-    return Identification(measured, damping[order_of], frfs, (lower, upper), order, stable,
-                          clusters, notes)
+    measured = make_measured(frfs.x, dof, nat_freq, shapes, frfs.source,
+                             np.clip(damping, 0.0, 0.999))
+    persistence = np.array([max((c[1] for c in keep if abs(c[0] / f - 1) < 0.02),
+                                default=0.0) for f in measured.frequencies_hz])
+    # sdypy-EMA keeps the lines up to the band's upper end; the fit holds inside the band
+    used = np.asarray(model.freq, float)
+    inside = (used >= lower) & (used <= upper)
+    fitted, measured_frf = np.asarray(H)[:, inside], np.asarray(model.frf)[:, inside]
+    error = float(np.sqrt(np.mean(np.abs(fitted - measured_frf) ** 2))
+                  / np.sqrt(np.mean(np.abs(measured_frf) ** 2)))
+    return Identification(measured, measured.damping, frfs, (lower, upper), order, stable,
+                          clusters, persistence, error, notes)
 
 
-def _clusters(stable, n_orders):
+def _on_fft_grid(frf, freq, notes):
+    """FRFs on lines k·Δf.  sdypy-EMA's LSCF works in the discrete-time domain of an FFT
+    and pads lines below the first from 0 in steps of Δf: lines starting off that grid (a
+    zoom band from 20 Hz in steps of 1.42 Hz) or unevenly spaced shift every pole (0.2 % at
+    the first mode in tests/test_identify.py).  Such FRFs are resampled (cubic splines on the
+    real and imaginary parts) onto the grid of their median spacing, with a note."""
+    from scipy.interpolate import CubicSpline
+
+    steps = np.diff(freq)
+    df = float(np.median(steps))
+    uniform = np.all(np.abs(steps / df - 1) < 1e-6)
+    aligned = abs(freq[0] / df - round(freq[0] / df)) < 1e-6
+    if uniform and aligned:
+        return frf, freq
+    grid = np.arange(np.ceil(freq[0] / df - 1e-9), np.floor(freq[-1] / df + 1e-9) + 1) * df
+    spline = CubicSpline(freq, frf, axis=1)
+    why = "unevenly spaced" if not uniform else f"starting at {freq[0]:g} Hz, off the grid k·Δf"
+    notes.append(f"frequency lines {why}: FRFs resampled onto {grid.size} lines k·{df:.4g} Hz "
+                 "(sdypy-EMA's LSCF assumes FFT lines)")
+    return spline(grid), grid
+
+
+def _clusters(stable, n_orders, members=False):
     """Stable pole frequencies of all orders grouped (sorted, a new group where the gap to
     the previous exceeds CLUSTER_WIDTH relative); each group's median and the share of the
-    orders in which it appears."""
+    orders in which it appears (or, with ``members``, each group's (frequency, order))."""
     points = sorted((f, k) for k, fs in enumerate(stable) for f in fs)
     groups, current = [], []
     for f, k in points:
@@ -300,8 +335,32 @@ def _clusters(stable, n_orders):
         current.append((f, k))
     if current:
         groups.append(current)
+    if members:
+        return groups
     return [(float(np.median([f for f, _ in g])), len({k for _, k in g}) / n_orders)
             for g in groups]
+
+
+def _typical_pole(group, fn, xi, stable_mask):
+    """The stable pole of a cluster nearest its median frequency and damping (in units of
+    the stability tolerances), as (row, order) of ``fn``.  Taking the pole nearest in
+    frequency alone (sdypy-EMA's select_closest_poles) can take a spurious pole of a
+    near-noiseless fit whose damping is off by 90 %."""
+    candidates = []
+    for f, k in group:
+        rows = np.flatnonzero(stable_mask[:, k] & (fn[:, k] == f))
+        candidates += [(int(r), int(k)) for r in rows]
+    f_med = np.median([fn[r, k] for r, k in candidates])
+    xi_med = np.median([xi[r, k] for r, k in candidates])
+    return min(candidates, key=lambda rk: abs(fn[rk] / f_med - 1) / STABLE_FREQUENCY
+               + abs(xi[rk] / xi_med - 1) / STABLE_DAMPING)
+
+
+def _pole_index(poles, f, zeta):
+    """Index, among one order's poles, of the pole with frequency f and damping ζ."""
+    w = 2 * np.pi * f
+    target = -zeta * w + 1j * w * np.sqrt(1 - zeta**2)
+    return int(np.argmin(np.abs(np.asarray(poles) - target)))
 
 
 def _real_shapes(constants) -> np.ndarray:

@@ -345,13 +345,17 @@ def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
     if dof is None:
         dof = "w" if has_z or has_y else "u"
     comp = "r1" if dof == "u" else ("r3" if has_z or not has_y else "r2")
-    shapes, freqs = [], []
+    shapes, freqs, damping = [], [], []
     for i, m in enumerate(modes):
         if [int(n) for n in np.asarray(m["node_nums"]).astype(int)] != nodes:
             raise GfeInputError(where, f"dataset 55 #{i + 1}", "nodes differ from the first mode")
         shapes.append(np.real(np.asarray(m[comp], dtype=complex)))
         freqs.append(float(m["freq"]))
-    return make_measured([coords[n] for n in nodes], dof, freqs, np.array(shapes).T, where)
+        damping.append(float(m.get("modal_damp_vis", 0.0) or 0.0))
+    # dataset 55 always has a damping field: zero everywhere means "not given"
+    damping = damping if any(d > 0 for d in damping) else None
+    return make_measured([coords[n] for n in nodes], dof, freqs, np.array(shapes).T, where,
+                         damping)
 
 
 # -------------------------------------------------------------------------------------------
@@ -416,7 +420,8 @@ def _write_uff(m: MeasuredModes, path) -> None:
             id1=f"gfe-opt mode {j + 1}", id2="NONE", id3="NONE", id4="NONE", id5="NONE",
             model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, data_type=2,
             n_data_per_node=3, load_case=1, mode_n=j + 1, freq=float(f), modal_m=0.0,
-            modal_damp_vis=0.0, modal_damp_his=0.0, node_nums=nodes,
+            modal_damp_vis=float(np.nan_to_num(m.damping[j])) if m.damping is not None
+            else 0.0, modal_damp_his=0.0, node_nums=nodes,
             **comp))
     pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")
 

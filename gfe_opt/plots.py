@@ -184,3 +184,32 @@ def nodal_coefficients(realisations):
     bottom.set_xlabel("x [m]")
     bottom.legend(fontsize=8)
     return fig
+
+
+def stabilisation(identification):
+    """Stabilisation chart: stable poles per model order over the summed FRF magnitude, the
+    modes kept marked."""
+    ident = identification
+    fig = _figure(7.0, 4.0)
+    ax = fig.add_subplot()
+    frfs = ident.frfs
+    band = (frfs.freq >= ident.band[0]) & (frfs.freq <= ident.band[1])
+    magnitude = np.sum(np.abs(frfs.frf[:, band]), axis=0)
+    ax2 = ax.twinx()
+    ax2.semilogy(frfs.freq[band], magnitude, color="0.6", lw=0.8)
+    ax2.set_ylabel(f"Σ|FRF| ({frfs.form})", color="0.4")
+    orders = np.arange(1, len(ident.stable) + 1)
+    for order, poles in zip(orders, ident.stable):
+        ax.plot(poles, np.full(len(poles), order), "+", color="tab:blue", ms=4, mew=0.8)
+    ax.plot([], [], "+", color="tab:blue", label="stable pole (Δf < 0.1 %, Δζ < 5 %)")
+    for k, f in enumerate(ident.measured.frequencies_hz):
+        ax.axvline(f, color="tab:red", lw=0.8, ls="--",
+                   label="identified mode" if k == 0 else None)
+    ax.set_xlim(ident.band)
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("model order")
+    ax.set_zorder(ax2.get_zorder() + 1)
+    ax.patch.set_visible(False)
+    ax.legend(fontsize=8, loc="upper left")
+    ax.set_title("Stabilisation chart (LSCF)")
+    return fig

@@ -100,7 +100,19 @@ def format_diagnosis(result, model) -> str:
                      f"{best.misfit.freq_error_rms_pct:.3f} %, χ²/n "
                      f"{_ratio(now.chi2_per_residual)} -> "
                      f"{_ratio(best.misfit.chi2_per_residual)}")
-        lines.append(f"  add it: gfe-opt update MODEL MEASURED --add {best.name}")
+        pair = result.together
+        if pair is not None:
+            added = pair.effects[len(model.effects):]
+            lines.append("  with " + "; ".join(
+                f"{e.name}: {effect_type(e.name).describe(e.parameters, s)}"
+                for e, s in zip(added[1:], pair.sigma[len(model.effects) + 1:])))
+            lines.append(f"  together: frequency error {now.freq_error_rms_pct:.3f} % -> "
+                         f"{pair.misfit.freq_error_rms_pct:.3f} %, χ²/n "
+                         f"{_ratio(now.chi2_per_residual)} -> "
+                         f"{_ratio(pair.misfit.chi2_per_residual)}")
+        adds = " ".join(f"--add {name}" for name in result.suggested)
+        them = "it" if len(result.suggested) == 1 else "them"
+        lines.append(f"  add {them}: gfe-opt update MODEL MEASURED {adds}")
     elif result.verdict == "unexplained":
         where = ("where the model fails: " + ", ".join(f"x = {x:.3f} m" for x, _ in
                                                        result.localisation)
@@ -121,6 +133,22 @@ def format_update(outcome) -> str:
         lines.append(f"  {e.name} ({mark}): {effect_type(e.name).describe(e.parameters, sigma)}")
     lines.append(misfit_line(outcome.after, "after"))
     lines += [f"note: {n}" for n in outcome.notes]
+    return "\n".join(lines)
+
+
+def format_identification(result) -> str:
+    """The modes identified from FRFs, with damping and how stable each was."""
+    ident = result
+    lines = [f"{ident.frfs.frf.shape[0]} FRFs ({ident.frfs.form}) at x = "
+             + ", ".join(f"{x:.4g}" for x in ident.frfs.x) + " m; band "
+             f"{ident.band[0]:.5g} to {ident.band[1]:.5g} Hz, LSCF orders up to {ident.order}",
+             f"{'mode':>4}  {'f [Hz]':>10}  {'ζ [%]':>7}  {'stable in':>9}"]
+    for j, (f, z) in enumerate(zip(ident.measured.frequencies_hz, ident.damping)):
+        share = ident.persistence[j]
+        lines.append(f"{j + 1:>4}  {f:10.4f}  {100 * z:7.3f}  {100 * share:8.0f}%")
+    lines.append(f"FRF reconstruction error {100 * ident.fit_error:.2g} % (rms over the band, "
+                 "relative to the rms FRF)")
+    lines += [f"note: {n}" for n in ident.notes]
     return "\n".join(lines)
 
 

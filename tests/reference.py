@@ -230,3 +230,55 @@ class ReferenceBar:
                            for j in range(n_modes)], 1)
         freqs = np.sqrt(np.maximum(lam[order], 0.0)) / (2 * np.pi)
         return add_noise(freqs, shapes, shape_noise, freq_noise, seed)
+
+
+# -------------------------------------------------------------------------------------------
+# FRFs of a damped structure (modal superposition of the reference modes)
+# -------------------------------------------------------------------------------------------
+
+UFF_FORM_CODES = {"receptance": 8, "mobility": 11, "accelerance": 12}
+
+
+def synthesise_frfs(natural_hz, shapes, damping, freq, reference, *, form="accelerance",
+                    noise=0.0, seed=0):
+    """FRFs H_j(f) = Σ_n φ_jn φ_ref,n (iω)^k / (ω_n² − ω² + 2iζ_n ω_n ω) at the points of
+    ``shapes`` (n_points, n_modes, mass-normalised or not: the scale is irrelevant here),
+    excited or measured at point ``reference``; k = 0, 1, 2 for receptance, mobility,
+    accelerance.  Complex Gaussian noise of ``noise`` times each FRF's largest magnitude."""
+    w = 2 * np.pi * np.asarray(freq, float)[:, None]
+    wn = 2 * np.pi * np.asarray(natural_hz, float)[None, :]
+    zeta = np.asarray(damping, float)[None, :]
+    power = {"receptance": 0, "mobility": 1, "accelerance": 2}[form]
+    modal = (1j * w) ** power / (wn**2 - w**2 + 2j * zeta * wn * w)
+    H = np.array([np.sum(shapes[j] * shapes[reference] * modal, axis=1)
+                  for j in range(shapes.shape[0])])
+    if noise:
+        rng = np.random.default_rng(seed)
+        scale = noise * np.abs(H).max(axis=1, keepdims=True) / np.sqrt(2)
+        H = H + scale * (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape))
+    return H
+
+
+def write_uff58(path, x, freq, H, reference, *, form="accelerance", roving="hammer"):
+    """A universal file: node coordinates (2411) and one dataset 58 per point; with a roving
+    hammer the response node is ``reference`` in every FRF, with a roving accelerometer the
+    reference (excitation) node is."""
+    import pyuff
+
+    n = len(x)
+    nodes = np.arange(1, n + 1)
+    sets = [pyuff.prepare_2411(node_nums=nodes, def_cs=np.zeros(n, int),
+                               disp_cs=np.zeros(n, int), color=np.ones(n, int),
+                               x=np.asarray(x, float), y=np.zeros(n), z=np.zeros(n),
+                               return_full_dict=True)]
+    for j in range(n):
+        rsp, ref = (reference + 1, j + 1) if roving == "hammer" else (j + 1, reference + 1)
+        sets.append(pyuff.prepare_58(
+            func_type=4, rsp_node=rsp, rsp_dir=3, ref_node=ref, ref_dir=3,
+            ordinate_spec_data_type=UFF_FORM_CODES[form], abscissa_spec_data_type=18,
+            data=np.asarray(H[j], complex), x=np.asarray(freq, float), id1=f"FRF {j + 1}",
+            rsp_ent_name="beam", ref_ent_name="beam", abscissa_spacing=1,
+            abscissa_min=float(freq[0]), abscissa_inc=float(freq[1] - freq[0]),
+            num_pts=len(freq), ver_num=0, load_case_id=0, z_axis_value=0.0,
+            orddenom_spec_data_type=13, z_axis_spec_data_type=0))
+    pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")

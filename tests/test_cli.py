@@ -85,8 +85,10 @@ def test_diagnose_json_contract(files, capsys):
                  "--candidates", "material,crack"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert set(data) == {"verdict", "baseline", "noise", "effects", "failed", "skipped",
-                         "indistinguishable", "realisation", "notes"}
-    assert data["indistinguishable"] == []
+                         "indistinguishable", "suggested", "together", "realisation",
+                         "notes"}
+    assert data["indistinguishable"] == [] and data["suggested"] == ["crack"]
+    assert data["together"] is None
     assert data["verdict"] == "effect_found"
     assert set(data["baseline"]) == {"freq_error_rms_pct", "mac_mean", "chi2_per_residual"}
     assert set(data["noise"]) == {"freq", "shape", "given", "implied_freq", "implied_shape"}

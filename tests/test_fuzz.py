@@ -11,6 +11,7 @@ thousand within a minute) or ``long`` (``python scripts/fuzz.py``, or
 import contextlib
 import io
 import json
+import os
 import tomllib
 
 import pytest
@@ -63,9 +64,11 @@ def seeds(tmp_path_factory):
     return texts
 
 
-def _run(argv):
+def _run(argv, cwd=None):
+    """Run the CLI in `cwd` (a bare value such as `--plot nan` is a path relative to it)."""
     out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+    with contextlib.chdir(cwd or os.getcwd()), contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(err):
         code = main(argv)
     return code, out.getvalue(), err.getvalue()
 
@@ -207,7 +210,7 @@ def test_mutated_files_never_crash(seeds, tmp_path, data):
                 "--force"]
     else:
         argv = [command[0], str(files["model.toml"]), str(files[measured]), *command[1:]]
-    _check(*_run(argv))
+    _check(*_run(argv, tmp_path))
 
 
 @settings(deadline=None, suppress_health_check=[HealthCheck.too_slow,
@@ -230,4 +233,4 @@ def test_mutated_options_never_crash(seeds, tmp_path, data):
             value = data.draw(st.sampled_from(VALUES))
             args.append(str(tmp_path / value) if value in ("out.toml", "out.json", "figs",
                                                            "r.html") else value)
-    _check(*_run(args))
+    _check(*_run(args, tmp_path))
