@@ -8,7 +8,9 @@ an internal error (a bug: one line, never a traceback).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -122,6 +124,32 @@ def build_parser() -> argparse.ArgumentParser:
     o.add_argument("--out", required=True, help="output file (.uff, .unv, .json or .csv)")
     o.add_argument("--modes", type=int, default=5, help="number of modes (default 5)")
     o.add_argument("--force", action="store_true", help="overwrite an existing --out file")
+
+    b = sub.add_parser("batch", help="diagnose (or update) every measured set of a folder; "
+                       "one table row per set (Parquet or CSV), resumable, local or on Dask")
+    b.add_argument("model", help="model file (.toml)")
+    b.add_argument("measured_dir", help="folder of measured files (.json, .csv, .uff, .unv)")
+    b.add_argument("--out", required=True, help="results table (.parquet or .csv); a rerun "
+                   "with the same --out skips the sets already done")
+    b.add_argument("--add", action="append", default=[], metavar="EFFECT",
+                   help="update these effects in every set instead of diagnosing "
+                        "(repeatable, as for update)")
+    b.add_argument("--scheduler", metavar="tcp://HOST:8786",
+                   help="run the sets on this Dask distributed scheduler (default: a local "
+                        "pool of processes on this machine)")
+    b.add_argument("--workers", type=int, default=None,
+                   help="local processes (default: every core)")
+    b.add_argument("--force", action="store_true",
+                   help="start over: discard an existing --out and its journal")
+    noise_options(b)
+
+    t = sub.add_parser("trend", help="draw a batch table: each parameter against time or "
+                       "label with its band, the error before and after")
+    t.add_argument("results", help="results table of gfe-opt batch (.parquet or .csv)")
+    t.add_argument("--plot", metavar="DIR", help="write trend.png and error.png into DIR")
+    t.add_argument("--report", metavar="FILE.html", help="write a self-contained HTML report")
+    t.add_argument("--json", action="store_true", help="print the trend summary as JSON")
+    t.add_argument("--force", action="store_true", help="overwrite existing output files")
 
     i = sub.add_parser("identify", help="identify modes (frequencies, damping, shapes) from "
                        "measured FRFs (UFF 58 or CSV)")
@@ -377,6 +405,41 @@ def cmd_identify(args) -> int:
     return 0
 
 
+def cmd_batch(args) -> int:
+    from .batch import run_batch
+    from .text import batch_progress, format_batch
+
+    result = run_batch(args.model, args.measured_dir, args.out, add=args.add,
+                       scheduler=args.scheduler, workers=args.workers,
+                       freq_noise=args.freq_noise, shape_noise=args.shape_noise,
+                       force=args.force, progress=batch_progress())
+    print(format_batch(result))
+    return 1 if result.failed else 0
+
+
+def cmd_trend(args) -> int:
+    from .batch import read_table
+    from .inputs import check_input_file
+    from .text import format_trend
+    from .trend import trend
+
+    check_input_file(Path(args.results), "results")
+    _check_outputs(args, ("trend.png", "error.png"))
+    result = trend(read_table(args.results), args.results)
+    if args.json:
+        print(json.dumps(result.to_json(), indent=1))
+    else:
+        print(format_trend(result))
+    from . import plots
+
+    figs = {"trend.png": _figures(plots.trend_parameters, result),
+            "error.png": _figures(plots.trend_errors, result)} \
+        if args.plot or args.report else {}
+    _write_outputs(args, figs, lambda report: report.preformatted(format_trend(result)),
+                   f"gfe-opt trend: {Path(args.results).name}")
+    return 0
+
+
 def cmd_demo(args) -> int:
     from .demo import run_demo
 
@@ -395,6 +458,7 @@ def main(argv=None) -> int:
         with np.errstate(all="ignore"):
             return {"compare": cmd_compare, "diagnose": cmd_diagnose, "update": cmd_update,
                     "modes": cmd_modes, "identify": cmd_identify,
+                    "batch": cmd_batch, "trend": cmd_trend,
                     "demo": cmd_demo}[args.command](args)
     except GfeInputError as exc:
         print(f"gfe-opt: error: {_one_line(exc)}", file=sys.stderr)
@@ -402,6 +466,10 @@ def main(argv=None) -> int:
     except GfeSolverError as exc:
         print(f"gfe-opt: solver failed: {_one_line(exc)}", file=sys.stderr)
         return 1
+    except BrokenPipeError:  # output piped into a reader that stopped (| head): not an error
+        with contextlib.suppress(OSError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except KeyboardInterrupt:
         print("gfe-opt: interrupted (nothing half-written: outputs are written whole or not "
               "at all)", file=sys.stderr)

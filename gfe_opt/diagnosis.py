@@ -303,7 +303,7 @@ def _job(args):
 def _run_jobs(jobs, progress, labels):
     """Run fits, in parallel over the machine's cores (fork, one BLAS thread per worker;
     serial where processes cannot be forked or only one core is there); results in order."""
-    workers = min(len(jobs), os.cpu_count() or 1)
+    workers = 1 if SERIAL_FITS else min(len(jobs), os.cpu_count() or 1)
     results = [None] * len(jobs)
     if progress:
         progress(0, len(jobs), "")
@@ -348,6 +348,9 @@ def _single_threaded_blas():
 
 
 _BLAS_LIMIT = None
+#: fits one after another in this process (set by batch workers: the sets are the parallelism,
+#: and a Dask worker's daemon process may not fork)
+SERIAL_FITS = False
 
 
 # -------------------------------------------------------------------------------------------
@@ -547,7 +550,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                            noise)
         words = (describe_profile(band, found.name if found else None) if band is not None
                  else [])
-    estimate = _noise_estimate(model, measured, noise, [*ranked, reference], C, ref_misfit,
+    estimate = _noise_estimate(model, measured, noise, [*ranked, reference, together], C,
+                               ref_misfit,
                                sel.floor)
     verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate)
     if verdict == "effect_found" and not suggested:
@@ -561,7 +565,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             notes.append("the generic-element update needs mode shapes: not run")
     notes += _noise_notes(estimate, verdict)
     if skipped:
-        notes.append("not tried: " + "; ".join(f"{n} ({r})" for n, r in skipped))
+        notes.append(_skipped_note(skipped, measured, model))
     return Diagnosis(baseline=baseline, reference=reference, fits=ranked, failed=failed,
                      skipped=skipped, verdict=verdict, noise=estimate, alike=alike,
                      suggested=suggested if verdict == "effect_found" else [],
@@ -570,6 +574,21 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                      realisation=_words_for_verdict(words or [], verdict),
                      nodal=nodal or [], generic_update=generic, profile_band=band,
                      notes=notes)
+
+
+def _skipped_note(skipped, measured, model) -> str:
+    """One sentence for the candidates not tried; those stopped by the frequency budget
+    (two frequencies per parameter) are named together."""
+    budget = [n for n, r in skipped if "two per parameter" in r]
+    rest = [(n, r) for n, r in skipped if n not in budget]
+    parts = []
+    if budget:
+        held = sum(fitted_parameter_count(e.name) for e in model.effects)
+        parts.append(f"{', '.join(budget)} ({measured.n_modes} frequencies alone judge at "
+                     f"most {measured.n_modes // 2} parameters; the model's effects hold "
+                     f"{held})")
+    parts += [f"{n} ({r})" for n, r in rest]
+    return "not tried: " + "; ".join(parts)
 
 
 def _discretise(model):

@@ -14,7 +14,7 @@ from .errors import GfeInputError
 
 MiB = 1024 * 1024
 #: the largest input files read (refused before they are parsed)
-FILE_LIMITS = {"model": 1 * MiB, "measured": 200 * MiB}
+FILE_LIMITS = {"model": 1 * MiB, "measured": 200 * MiB, "results": 4096 * MiB}
 #: the finest meshes: beams, the modal solve is verified up to there (gfe_opt.modal); bars,
 #: a million elements take 1 GB and 6 s a modal solve, three million fail its check
 MAX_ELEMENTS = {"beam": 30_000, "bar": 1_000_000}

@@ -31,7 +31,8 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -63,6 +64,8 @@ class MeasuredModes:
     shapes: np.ndarray
     source: str = "measured"
     damping: np.ndarray | None = None
+    time: str | float | None = None    # when the test was made (ISO 8601 text or a number)
+    label: str | None = None           # a name for the test (batch tables and trends)
 
     @property
     def n_modes(self) -> int:
@@ -208,8 +211,10 @@ def _read_json(path: Path) -> MeasuredModes:
     if not isinstance(data, dict):
         raise GfeInputError(where, None, "top level must be an object with sensors and modes")
     for key in data:
-        if key not in ("sensors", "modes"):
-            raise GfeInputError(where, key, "unknown key (expected sensors, modes)")
+        if key not in ("sensors", "modes", "time", "label"):
+            raise GfeInputError(where, key, "unknown key (expected sensors, modes, time, "
+                                "label)")
+    stamp = _time_and_label(data.get("time"), data.get("label"), where)
     modes = data.get("modes")
     if not isinstance(modes, list) or not modes:
         raise GfeInputError(where, "modes", "missing or empty (a list of modes)")
@@ -257,10 +262,28 @@ def _read_json(path: Path) -> MeasuredModes:
         damping.append(mode.get("damping", np.nan))
     damping = None if all(np.isnan(d) for d in damping) else damping
     if not shaped:
-        return make_measured(None, (sensors or {}).get("dof", "w"), freqs, None, where,
-                             damping)
-    return make_measured(sensors["x"], sensors.get("dof", "w"), freqs,
-                         np.array(shapes, dtype=float).T, where, damping)
+        return replace(make_measured(None, (sensors or {}).get("dof", "w"), freqs, None,
+                                     where, damping), **stamp)
+    return replace(make_measured(sensors["x"], sensors.get("dof", "w"), freqs,
+                                 np.array(shapes, dtype=float).T, where, damping), **stamp)
+
+
+def _time_and_label(time, label, where) -> dict:
+    """The optional ``time`` (ISO 8601 text such as ``2026-03-01T12:00``, or a number in
+    the user's unit) and ``label`` (text) of a measured set, checked."""
+    if time is not None:
+        if isinstance(time, str):
+            try:
+                datetime.fromisoformat(time)
+            except ValueError:
+                raise GfeInputError(where, "time", f"not an ISO 8601 date/time: {time!r} "
+                                    "(e.g. 2026-03-01T12:00), or give a number") from None
+        elif not _is_number(time) or not np.isfinite(time):
+            raise GfeInputError(where, "time", f"must be ISO 8601 text or a number, got "
+                                f"{time!r}")
+    if label is not None and not isinstance(label, str):
+        raise GfeInputError(where, "label", f"must be text, got {label!r}")
+    return {"time": time, "label": label}
 
 
 def _is_number(v):
@@ -291,7 +314,24 @@ def _read_csv(path: Path, dof: str) -> MeasuredModes:
             raise GfeInputError(where, f"row {i}", f"non-numeric cell in {row}") from None
         x.append(vals[0])
         shapes.append(vals[1:])
-    return make_measured(x, dof, freqs, np.array(shapes) if x else None, where)
+    stamp = {}
+    for line in read_text(path, "measured").splitlines():
+        key, sep, value = line.lstrip().lstrip("#").partition(":")
+        if line.lstrip().startswith("#") and sep and key.strip() in ("time", "label"):
+            value = value.strip()
+            stamp[key.strip()] = (float(value) if key.strip() == "time"
+                                  and _looks_numeric(value) else value)
+    stamp = _time_and_label(stamp.get("time"), stamp.get("label"), where)
+    return replace(make_measured(x, dof, freqs, np.array(shapes) if x else None, where),
+                   **stamp)
+
+
+def _looks_numeric(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _check_uff_complete(path: Path) -> None:
@@ -375,7 +415,8 @@ def measured_to_dict(m: MeasuredModes) -> dict:
             mode["shape"] = [float(v) for v in m.shapes[:, j]]
         modes.append(mode)
     out = {"sensors": {"x": [float(v) for v in m.x], "dof": m.dof}} if m.n_sensors else {}
-    return {**out, "modes": modes}
+    stamp = {k: v for k, v in (("time", m.time), ("label", m.label)) if v is not None}
+    return {**stamp, **out, "modes": modes}
 
 
 def save_measured(m: MeasuredModes, path, *, force: bool = False, protect=()) -> None:
@@ -447,8 +488,9 @@ def on_model(measured: MeasuredModes, model) -> tuple[MeasuredModes, list[str]]:
     if np.all(drop):
         raise GfeInputError(measured.source, "sensors.x", "every sensor sits on a support "
                             "that holds the structure still: nothing to compare")
-    kept = make_measured(measured.x[~drop], measured.dof, measured.frequencies_hz,
-                         measured.shapes[~drop], measured.source, measured.damping)
+    kept = replace(make_measured(measured.x[~drop], measured.dof, measured.frequencies_hz,
+                                 measured.shapes[~drop], measured.source, measured.damping),
+                   time=measured.time, label=measured.label)
     where = ", ".join(f"x = {x:g} m" for x in measured.x[drop])
     return kept, [f"sensor{'s' if drop.sum() > 1 else ''} at {where} on a support that holds "
                   "the structure still: left out (it reads only noise)"]

@@ -142,15 +142,24 @@ def localisation(x, residual, comac, length, supports=("pinned", "pinned")):
     return fig
 
 
-def candidate_errors(fits, baseline_pct):
-    """Frequency error left by each candidate effect (significant ones coloured)."""
+def candidate_errors(fits, baseline_pct, together=None):
+    """Frequency error left by each candidate effect (significant ones coloured) and, when
+    a pair is suggested, by the pair (hatched, on top)."""
     fig = _figure(7.0, 3.2)
     ax = fig.add_subplot()
     names = [f.effect for f in fits]
     values = [f.misfit.freq_error_rms_pct for f in fits]
     colours = ["tab:green" if f.significant else "0.6" for f in fits]
-    ax.barh(names[::-1], values[::-1], color=colours[::-1])
-    ax.axvline(baseline_pct, color="tab:red", ls="--", lw=1, label="initial model")
+    hatches = [""] * len(fits)
+    if together is not None:
+        names.insert(0, " + ".join(e.name for e in together.effects[-2:]))
+        values.insert(0, together.misfit.freq_error_rms_pct)
+        colours.insert(0, "tab:green")
+        hatches.insert(0, "//")
+    bars = ax.barh(names[::-1], values[::-1], color=colours[::-1])
+    for bar, hatch in zip(bars, hatches[::-1]):
+        bar.set_hatch(hatch)
+    ax.axvline(baseline_pct, color="tab:red", ls="--", lw=1, label="model as it stands")
     ax.set_xlabel("frequency error left [% rms]")
     ax.set_title("Candidate effects (green: significant)")
     ax.legend(fontsize=8)
@@ -213,3 +222,71 @@ def stabilisation(identification):
     ax.legend(fontsize=8, loc="upper left")
     ax.set_title("Stabilisation chart (LSCF)")
     return fig
+
+
+def trend_parameters(trend):
+    """Each fitted parameter against time/label with its ±σ band; the first set where an
+    effect becomes significant marked."""
+    keys = list(trend.parameters)
+    fig = _figure(7.5, max(2.2, 1.9 * len(keys)) if keys else 2.5)
+    if not keys:
+        ax = fig.add_subplot()
+        ax.text(0.5, 0.5, "no fitted parameter in the table", ha="center", va="center")
+        ax.set_axis_off()
+        return fig
+    axes = fig.subplots(len(keys), 1, sharex=True, squeeze=False)[:, 0]
+    x = trend.x
+    for ax, key in zip(axes, keys):
+        values, sigmas = trend.parameters[key]
+        ax.plot(x, values, color="tab:blue", lw=1.2, marker="." if len(x) < 60 else None)
+        band = np.isfinite(sigmas)
+        if np.any(band):
+            lower = np.where(band, values - sigmas, np.nan)
+            upper = np.where(band, values + sigmas, np.nan)
+            ax.fill_between(x, lower, upper, color="tab:blue", alpha=0.25, lw=0,
+                            label="±1 σ")
+        finite = values[np.isfinite(values)]
+        if finite.size:  # the values set the scale; a set with a huge σ does not
+            typical = np.nanmedian(sigmas[band]) if np.any(band) else 0.0
+            pad = 0.1 * (finite.max() - finite.min()) + 2 * typical + 1e-12 * abs(finite).max()
+            ax.set_ylim(finite.min() - pad, finite.max() + pad)
+        effect = key.split(".")[0]
+        for onset in trend.onsets:
+            if onset.effect == effect:
+                ax.axvline(x[onset.index], color="tab:red", ls="--", lw=1,
+                           label=f"significant from {onset.when}")
+        ax.set_ylabel(key.replace("_", " "), fontsize=8)
+        ax.grid(alpha=0.3)
+        handles, _ = ax.get_legend_handles_labels()
+        if handles:
+            ax.legend(fontsize=7, loc="best")
+    axes[0].set_title(f"Fitted parameters over {len(x)} sets")
+    _trend_axis(axes[-1], trend)
+    return fig
+
+
+def trend_errors(trend):
+    """Frequency error before and after the fit of each set."""
+    fig = _figure(7.5, 2.8)
+    ax = fig.add_subplot()
+    ax.plot(trend.x, trend.errors_before, color="tab:red", lw=1.2, label="before")
+    ax.plot(trend.x, trend.errors_after, color="tab:green", lw=1.2, label="after")
+    ax.set_ylabel("frequency error [% rms]")
+    ax.set_yscale("log")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    ax.set_title("Frequency error of each set, before and after the fit")
+    _trend_axis(ax, trend)
+    return fig
+
+
+def _trend_axis(ax, trend):
+    if trend.axis == "time":
+        ax.set_xlabel("time")
+        ax.figure.autofmt_xdate()
+    elif trend.axis == "number":
+        ax.set_xlabel("time")
+    else:
+        ax.set_xlabel("set")
+        if len(trend.ticks) <= 20:
+            ax.set_xticks(trend.x, trend.ticks, rotation=30, ha="right", fontsize=7)

@@ -29,8 +29,9 @@ def diagnosis_figures(diagnosis, model) -> dict:
     """Candidate errors; with the generic update: its stiffness profile against the noise
     band and what the effect found would show, the nodal equation coefficients and (for a
     crack) the identified Q_i against Christides–Barr Q(x)."""
-    figs = {"candidates.png": plots.candidate_errors(diagnosis.fits,
-                                                     diagnosis.current.freq_error_rms_pct)}
+    figs = {"candidates.png": plots.candidate_errors(
+        diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together)
+            } if diagnosis.fits else {}
     band = diagnosis.profile_band
     best = diagnosis.best
     if band is not None:

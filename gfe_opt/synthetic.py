@@ -124,3 +124,48 @@ def closed_form_measurement(model: Model, effect: Effect | None, n_modes: int, s
         shapes.shape)
     freqs = np.sqrt(omega2) / (2 * np.pi) * (1 + freq_noise * rng.standard_normal(n_modes))
     return make_measured(sensors, "w", freqs, shapes, f"closed-form({name})")
+
+
+def campaign_truth(i: int, n_sets: int, *, onset=0.2, final_depth=0.5, swing=0.01,
+                   sets_per_day=24) -> tuple[float, float]:
+    """The truth of set ``i`` of a monitoring campaign: (crack depth a/d, E factor).  No
+    crack for the first ``onset`` of the sets, then a/d growing linearly to
+    ``final_depth`` at the last set; E moving ±``swing`` with a daily temperature cycle."""
+    start = int(round(onset * n_sets))
+    depth = 0.0 if i < start else final_depth * (i - start + 1) / max(n_sets - start, 1)
+    factor = 1.0 + swing * np.sin(2 * np.pi * i / sets_per_day)
+    return float(depth), float(factor)
+
+
+def write_campaign(model: Model, folder, n_sets: int, *, position=0.19, n_modes=5,
+                   sensors=None, shape_noise=0.003, freq_noise=0.0005, seed=0,
+                   reference_elements=400, **truth_options) -> list:
+    """Measured JSON files ``set-0001.json`` ... of a campaign on ``model`` (hourly
+    ``time`` stamps from 2026-01-01, ``label`` with the day and hour): truths from
+    :func:`campaign_truth` built on a fine independent mesh; returns the truths."""
+    import json
+    from datetime import datetime, timedelta
+    from pathlib import Path
+
+    from .measured import measured_to_dict
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    sensors = interior_sensors(model.length, 15) if sensors is None else sensors
+    start = datetime(2026, 1, 1)
+    truths = []
+    for i in range(n_sets):
+        depth, factor = campaign_truth(i, n_sets, **truth_options)
+        effects = [Effect("material", {"E": model.E * factor})]
+        if depth > 0:
+            effects.append(Effect("crack", {"position": position, "depth_ratio": depth}))
+        truth = model.with_effects(effects)
+        m = synthetic_measurement(truth, n_modes, sensors, shape_noise=shape_noise,
+                                  freq_noise=freq_noise, seed=seed + i,
+                                  reference_elements=reference_elements)
+        when = start + timedelta(hours=i)
+        data = {"time": when.isoformat(timespec="minutes"),
+                "label": f"day {i // 24 + 1} {when:%H}:00", **measured_to_dict(m)}
+        (folder / f"set-{i + 1:04d}.json").write_text(json.dumps(data))
+        truths.append((depth, factor))
+    return truths

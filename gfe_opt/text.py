@@ -80,10 +80,13 @@ def format_diagnosis(result, model) -> str:
     lines = [misfit_line(result.baseline, "the model as it stands")]
     if result.reference is not None:
         lines.append(misfit_line(now, "its effects re-estimated"))
-    lines += ["", "candidates, best first by χ²/s² + p ln n (significant: Δχ² exceeds 'needed' "
-              "and the effect lies 3 σ from nothing):",
-              f"{'rank':>4}  {'effect':<18} {'χ²/n':>8} {'f err %':>8} {'MAC':>7} "
-              f"{'Δχ²':>9} {'needed':>8} {'size σ':>7}  significant"]
+    if result.fits:
+        lines += ["", "candidates, best first by χ²/s² + p ln n (significant: Δχ² exceeds "
+                  "'needed' and the effect lies 3 σ from nothing):",
+                  f"{'rank':>4}  {'effect':<18} {'χ²/n':>8} {'f err %':>8} {'MAC':>7} "
+                  f"{'Δχ²':>9} {'needed':>8} {'size σ':>7}  significant"]
+    elif not result.failed:
+        lines += ["", "no candidate effect could be fitted (see the notes)"]
     for i, f in enumerate(result.fits, 1):
         lines.append(f"{i:>4}  {f.name:<18} {_ratio(f.misfit.chi2_per_residual):>8} "
                      f"{f.misfit.freq_error_rms_pct:8.3f} {_mac(f.misfit.mac_mean, 7, 4)} "
@@ -172,3 +175,76 @@ def terminal_progress(enabled: bool = True):
         print(f"\rfitting: {done}/{total} {name:<28}", end=end, file=sys.stderr, flush=True)
 
     return report
+
+
+def batch_progress():
+    """A one-line batch progress report on stderr when it is a terminal (else None)."""
+    if not sys.stderr.isatty():
+        return None
+
+    def report(done, total, failed, left):
+        eta = "" if left is None else f", about {_duration(left)} left"
+        end = "\n" if done == total else ""
+        print(f"\rbatch: {done}/{total} sets, {failed} failed{eta}    ", end=end,
+              file=sys.stderr, flush=True)
+
+    return report
+
+
+def _duration(seconds: float) -> str:
+    seconds = int(round(seconds))
+    if seconds < 60:
+        return f"{seconds} s"
+    if seconds < 3600:
+        return f"{seconds // 60} min {seconds % 60:02d} s"
+    return f"{seconds // 3600} h {seconds % 3600 // 60:02d} min"
+
+
+def format_batch(result) -> str:
+    """What a batch did, and where the table is."""
+    lines = [f"{len(result.rows)} sets in {result.out}: {result.ran} run now, "
+             f"{result.skipped} done before, {result.failed} failed "
+             f"({_duration(result.seconds)})"]
+    verdicts = {}
+    for row in result.rows:
+        if row["status"] == "ok":
+            verdicts[row.get("verdict")] = verdicts.get(row.get("verdict"), 0) + 1
+    if verdicts:
+        lines.append("verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(verdicts.items())))
+    for row in [r for r in result.rows if r["status"] != "ok"][:10]:
+        lines.append(f"failed: {row['file']}: {row['error']}")
+    if result.failed > 10:
+        lines.append(f"... and {result.failed - 10} more failed sets (status = error in "
+                     "the table)")
+    lines += result.notes
+    lines.append(f"next: gfe-opt trend {result.out} --plot DIR")
+    return "\n".join(lines)
+
+
+def format_trend(trend) -> str:
+    """Onsets, parameter ranges and failures of a campaign."""
+    n = len(trend.files)
+    lines = [f"{n} sets ({len(trend.failed)} failed) ordered by "
+             f"{'time' if trend.axis in ('time', 'number') else 'file name'}: "
+             f"{trend.ticks[0]} .. {trend.ticks[-1]}"]
+    for onset in trend.onsets:
+        params = ", ".join(f"{k} = {v:.4g}" for k, v in onset.value.items()
+                           if isinstance(v, (int, float)))
+        lines.append(f"{onset.effect} becomes significant at set {onset.index + 1} "
+                     f"({onset.file}, {onset.when}){': ' + params if params else ''}")
+    if not trend.onsets:
+        lines.append("no effect becomes significant during the campaign")
+    if trend.from_start:
+        lines.append("significant from the first set on: " + ", ".join(trend.from_start))
+    if trend.parameters:
+        lines += ["", f"{'parameter':<28} {'first':>12} {'last':>12} {'min':>12} {'max':>12}"]
+        for key, (values, _) in trend.parameters.items():
+            finite = values[np.isfinite(values)]
+            if not finite.size:
+                continue
+            cells = [values[0], values[-1], finite.min(), finite.max()]
+            lines.append(f"{key:<28} " + " ".join(f"{c:>12.5g}" for c in cells))
+    for file, error in trend.failed[:10]:
+        lines.append(f"failed: {file}: {error}")
+    lines += [f"note: {n}" for n in trend.notes]
+    return "\n".join(lines)

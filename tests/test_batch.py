@@ -1,0 +1,184 @@
+"""Monitoring campaigns: ``gfe-opt batch`` (local pool, Dask, resume) and ``gfe-opt trend``.
+
+The campaign is made by :func:`gfe_opt.synthetic.write_campaign`: each set's truth is built
+on a fine independent mesh (a Christides–Barr crack integrated with Hermite curvatures, not
+the exact-flexibility element that is updated), E moving ±1 % with a daily cycle, a crack
+appearing after a fifth of the sets and growing to a/d = 0.5.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import tomli_w
+
+from gfe_opt.batch import FIXED_COLUMNS, journal_path, read_table, run_batch
+from gfe_opt.cli import main
+from gfe_opt.model import model_from_dict
+from gfe_opt.synthetic import write_campaign
+from gfe_opt.trend import trend
+from tests.conftest import STEEL_BEAM
+
+SMALL = {**STEEL_BEAM, "elements": 20}
+ADD = ["material", "crack"]
+N_SETS = 10
+
+
+@pytest.fixture(scope="module")
+def campaign(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("campaign")
+    model = model_from_dict(SMALL, "small")
+    truths = write_campaign(model, tmp / "sets", N_SETS, n_modes=4, reference_elements=200,
+                            sensors=np.linspace(0.05, 0.525, 9), onset=0.3)
+    model_path = tmp / "model.toml"
+    model_path.write_text(tomli_w.dumps({**SMALL, "name": "small"}))
+    reference = run_batch(model_path, tmp / "sets", tmp / "reference.parquet", add=ADD,
+                          workers=1)
+    return tmp, model_path, truths, reference
+
+
+def _without_seconds(rows):
+    return [{k: v for k, v in r.items() if k != "seconds"} for r in rows]
+
+
+def test_rows_hold_every_fitted_parameter_and_the_crack_appears(campaign):
+    tmp, _, truths, reference = campaign
+    rows = read_table(tmp / "reference.parquet")
+    assert len(rows) == N_SETS and reference.failed == 0
+    assert list(rows[0])[:len(FIXED_COLUMNS)] == list(FIXED_COLUMNS)
+    for key in ("crack.depth_ratio", "crack.depth_ratio.sigma", "crack.position",
+                "crack.size_sigmas", "material.E", "material.E.sigma"):
+        assert key in rows[0], key
+    assert rows[0]["time"] == "2026-01-01T00:00" and rows[0]["label"] == "day 1 00:00"
+    assert all(r["freq_error_after_pct"] < r["freq_error_before_pct"] for r in rows)
+    t = trend(rows)
+    truth_depth = np.array([d for d, _ in truths])
+    first_crack = int(np.argmax(truth_depth > 0))
+    onsets = {o.effect: o for o in t.onsets}
+    assert "material" not in onsets  # E moving with temperature is drawn, not flagged
+    assert onsets["crack"].index >= first_crack  # no crack before it exists
+    assert truth_depth[onsets["crack"].index] < 0.15
+    found = t.parameters["crack.depth_ratio"][0]
+    late = truth_depth > 0.1
+    assert np.sqrt(np.mean((found[late] - truth_depth[late]) ** 2)) < 0.03
+    E = t.parameters["material.E"][0]
+    factors = np.array([f for _, f in truths])
+    np.testing.assert_allclose(E / SMALL["material"]["E"], factors, atol=0.004)
+
+
+def test_workers_and_formats_give_the_same_table(campaign, tmp_path):
+    tmp, model_path, _, _ = campaign
+    run_batch(model_path, tmp / "sets", tmp_path / "two.csv", add=ADD, workers=2)
+    reference = _without_seconds(read_table(tmp / "reference.parquet"))
+    assert _without_seconds(read_table(tmp_path / "two.csv")) == reference
+
+
+def test_killed_batch_resumes_to_the_same_table(campaign, tmp_path):
+    tmp, model_path, _, _ = campaign
+    out = tmp_path / "killed.parquet"
+    command = [sys.executable, "-m", "gfe_opt", "batch", str(model_path),
+               str(tmp / "sets"), "--out", str(out), "--workers", "1"]
+    for effect in ADD:
+        command += ["--add", effect]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    journal = journal_path(out)
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        if journal.exists() and journal.read_text().count("\n") >= 3:
+            break
+        time.sleep(0.05)
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    assert not out.exists()
+    done = journal.read_text().count("\n")
+    assert 3 <= done < N_SETS
+    with open(journal, "a") as handle:
+        handle.write('{"file": "set-00')  # a line cut short by the kill
+    result = run_batch(model_path, tmp / "sets", out, add=ADD, workers=2)
+    assert result.skipped == done and result.ran == N_SETS - done
+    assert not journal.exists()
+    reference = _without_seconds(read_table(tmp / "reference.parquet"))
+    assert _without_seconds(read_table(out)) == reference
+
+
+def test_dask_cluster_gives_the_same_table(campaign, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    tmp, model_path, _, _ = campaign
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        result = run_batch(model_path, tmp / "sets", tmp_path / "dask.parquet", add=ADD,
+                           scheduler=cluster.scheduler_address)
+    assert result.failed == 0 and result.ran == N_SETS
+    reference = _without_seconds(read_table(tmp / "reference.parquet"))
+    assert _without_seconds(read_table(tmp_path / "dask.parquet")) == reference
+
+
+def test_bad_sets_are_rows_and_the_exit_code_says_so(campaign, tmp_path, capsys):
+    tmp, model_path, _, _ = campaign
+    folder = tmp_path / "sets"
+    folder.mkdir()
+    for name in ("set-0001.json", "set-0002.json"):
+        (folder / name).write_bytes((tmp / "sets" / name).read_bytes())
+    (folder / "set-0003.json").write_text('{"modes": [}')
+    (folder / "notes.txt").write_text("not a measured file")
+    out = tmp_path / "r.csv"
+    argv = ["batch", str(model_path), str(folder), "--out", str(out), "--add", "material"]
+    assert main(argv) == 1
+    text = capsys.readouterr().out
+    assert "3 sets" in text and "1 failed" in text and "set-0003.json" in text
+    rows = read_table(out)
+    assert [r["status"] for r in rows] == ["ok", "ok", "error"]
+    assert "not valid JSON" in rows[2]["error"] and "gfe-batch-" not in rows[2]["error"]
+    # the same --out with another task is refused; --force starts over
+    assert main([*argv[:-1], "crack"]) == 2
+    assert "another model or task" in capsys.readouterr().err
+    assert main([*argv[:-1], "crack", "--force"]) == 1
+    assert read_table(out)[0]["task"] == "update crack"
+
+
+def test_batch_input_errors_are_one_line(campaign, tmp_path, capsys):
+    tmp, model_path, _, _ = campaign
+    (tmp_path / "empty").mkdir()
+    cases = [
+        (["batch", str(model_path), str(tmp_path / "empty"), "--out", "r.csv"],
+         "holds no measured file"),
+        (["batch", str(model_path), str(tmp / "sets"), "--out", str(tmp_path / "r.txt")],
+         ".parquet or .csv"),
+        (["batch", str(model_path), str(tmp_path / "none"), "--out", "r.csv"],
+         "not a folder"),
+        (["batch", str(model_path), str(tmp / "sets"), "--out", str(tmp_path / "r.csv"),
+          "--add", "crak"], "crak"),
+        (["batch", str(model_path), str(tmp / "sets"), "--out", str(tmp_path / "r.csv"),
+          "--workers", "0"], "--workers"),
+        (["batch", str(model_path), str(tmp / "sets"), "--out", str(tmp_path / "r.csv"),
+          "--scheduler", "tcp://127.0.0.1:1"], "no Dask scheduler answers"),
+        (["trend", str(tmp_path / "missing.parquet")], "missing.parquet"),
+    ]
+    for argv, match in cases:
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and match in err, err
+
+
+def test_trend_cli_draws_and_reports(campaign, tmp_path, capsys):
+    tmp, _, _, _ = campaign
+    argv = ["trend", str(tmp / "reference.parquet"), "--plot", str(tmp_path / "figs"),
+            "--report", str(tmp_path / "trend.html")]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "crack becomes significant at set" in text
+    for name in ("trend.png", "error.png"):
+        assert (tmp_path / "figs" / name).stat().st_size > 10_000
+    assert "crack becomes significant" in (tmp_path / "trend.html").read_text()
+    assert main([*argv[:2], "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["sets"] == N_SETS and [o["effect"] for o in data["onsets"]] == ["crack"]
+    assert main(argv) == 2  # figures exist: not overwritten without --force
+    assert "exists" in capsys.readouterr().err
