@@ -122,6 +122,12 @@ def test_active_constraint_hands_the_step_to_ipopt():
     assert free.solver == "direct" and not active_constraints(free)
 
 
+def _taper_measured(model):
+    ref = reference_with_rigidity(model, _taper(model), 2 * model.elements)
+    freqs, shapes = full_shapes_at_nodes(ref, model, 5)
+    return make_measured(model.nodes[1:-1], "w", freqs, shapes[2:-2:2], "reference")
+
+
 def test_energy_weighting_recovers_a_taper_on_10000_elements():
     # 5 modes, translations at every node of 10,000 elements from a 20,000-element reference:
     # the row-weighted residual (K - ω²M)φ amplifies rounding in φ by (N/jπ)^4 ~ 1e14 and
@@ -140,6 +146,13 @@ def test_energy_weighting_recovers_a_taper_on_10000_elements():
         errors[weighting] = np.max(np.abs(k / rigidity(model.nodes) - 1)[middle])
     assert errors["energy"] < 0.025   # measured 0.020 (0.5 % on the middle 80 %)
     assert errors["rows"] > 5 * errors["energy"]   # measured 0.24
+    # the default chooses the weighting from the mesh: energy here, rows on the paper's mesh
+    auto = update_generic(model, measured, noise=0.0)
+    assert auto.stats["weighting"] == "energy"
+    np.testing.assert_array_equal(auto.q, result.q)
+    coarse = make_model(elements=46)
+    assert update_generic(coarse, _taper_measured(coarse), noise=0.0).stats["weighting"] \
+        == "rows"
 
 
 def test_cross_check_reports_disagreement():
