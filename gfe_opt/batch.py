@@ -88,7 +88,7 @@ def run_set(task: Task, name: str, data: bytes) -> dict:
     start = time.perf_counter()
     row = {"file": name, "sha1": hashlib.sha1(data).hexdigest(), "task": task.label,
            "model_sha1": task.model_sha1, "status": "ok", "error": None}
-    diagnosis.SERIAL_FITS = True
+    serial, diagnosis.SERIAL_FITS = diagnosis.SERIAL_FITS, True
     try:
         with tempfile.TemporaryDirectory(prefix="gfe-batch-") as tmp, \
                 threadpool_limits(limits=1):
@@ -101,6 +101,8 @@ def run_set(task: Task, name: str, data: bytes) -> dict:
         row.update(status="error", error=str(exc).replace(str(Path(tmp)) + os.sep, ""))
     except Exception as exc:  # a solver failure or a bug: a row, and the batch goes on
         row.update(status="error", error=f"{type(exc).__name__}: {exc}")
+    finally:
+        diagnosis.SERIAL_FITS = serial
     row["seconds"] = round(time.perf_counter() - start, 3)
     return row
 
@@ -338,8 +340,9 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
         rows = _clean(kept + new_rows)
         if rows:
             write_table(rows, out)
-            if len(new_rows) == len(todo) and journal.exists():
-                journal.unlink()
+        if journal.exists() and (len(new_rows) == len(todo) and rows
+                                 or journal.stat().st_size == 0):
+            journal.unlink()  # all in the table, or nothing was written
     failed = sum(1 for r in rows if r["status"] != "ok")
     return BatchResult(sorted(rows, key=lambda r: r["file"]), len(new_rows), skipped, failed,
                        time.perf_counter() - start, out)

@@ -67,7 +67,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="gfe-opt",
         description="Finite-element model updating with generic elements: compare a beam or "
                     "bar model with measured modes and see where it fails.")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    parser.add_argument("--version", action="version", version=f"gfe-opt {_version()}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser,
+                                metavar="COMMAND")
 
     p = sub.add_parser("compare", help="pair model and measured modes; localise the error")
     p.add_argument("model", help="model file (.toml)")
@@ -75,9 +77,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--mac-threshold", type=_fraction, default=DEFAULT_MAC_THRESHOLD,
                    help="lowest MAC for a pair (default %(default)s)")
-    p.add_argument("--noise", type=_fraction, default=DEFAULT_SHAPE_NOISE,
-                   help="relative shape noise that regularises the expansion "
-                        "(default %(default)s)")
+    p.add_argument("--shape-noise", "--noise", dest="shape_noise", type=_fraction,
+                   default=DEFAULT_SHAPE_NOISE,
+                   help="shape noise relative to each mode's largest amplitude; here it "
+                        "regularises the expansion of the shapes, for which a generous "
+                        "value is safe (default %(default)s; --noise is the old name)")
 
     def output_options(p):
         p.add_argument("--plot", metavar="DIR", help="write the figures as PNG into DIR")
@@ -119,7 +123,8 @@ def build_parser() -> argparse.ArgumentParser:
     noise_options(u)
     output_options(u)
 
-    o = sub.add_parser("modes", help="write a model's modes (w at the nodes) as UFF 55")
+    o = sub.add_parser("modes", help="write a model's modes at its nodes (UFF 2411 + 55, "
+                       "JSON or CSV)")
     o.add_argument("model", help="model file (.toml)")
     o.add_argument("--out", required=True, help="output file (.uff, .unv, .json or .csv)")
     o.add_argument("--modes", type=int, default=5, help="number of modes (default 5)")
@@ -247,7 +252,7 @@ def cmd_compare(args) -> int:
     _check_outputs(args, COMPARE_FIGURES)
     model = load_model(args.model)
     measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
-    result = compare(model, measured, mac_threshold=args.mac_threshold, noise=args.noise)
+    result = compare(model, measured, mac_threshold=args.mac_threshold, noise=args.shape_noise)
     if args.json:
         print(json.dumps(result.to_json(), indent=1))
     else:
@@ -446,10 +451,23 @@ def cmd_demo(args) -> int:
     return run_demo(Path(args.out), force=args.force)
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("gfe-opt")
+    except PackageNotFoundError:
+        return "(not installed)"
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
         parser = build_parser()
+        if not argv:  # a bare call: what the tool does and its commands, not a usage error
+            parser.print_help()
+            print("gfe-opt: error: no command given (one of those above)", file=sys.stderr)
+            return 2
         try:
             args = parser.parse_args(argv)
         except SystemExit as exc:  # usage errors (2) and --help (0) from argparse

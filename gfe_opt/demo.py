@@ -32,14 +32,49 @@ def _indent(text: str) -> str:
     return "   " + text.replace("\n", "\n   ")
 
 
+MARKER = ".gfe-opt-demo.json"
+DEMO_FILES = ("model.toml", "measured.json", "updated.toml", "report.html")
+
+
+def _sha1(path: Path) -> str:
+    import hashlib
+
+    return hashlib.sha1(path.read_bytes()).hexdigest()
+
+
+def check_demo_folder(out: Path) -> None:
+    """A second demo may overwrite what the first wrote, as it wrote it (the hashes in
+    ``MARKER``); a file it did not write, or one changed since, needs ``force``."""
+    import json
+
+    marker = out / MARKER
+    written = {}
+    if marker.is_file():
+        try:
+            written = json.loads(marker.read_text())
+        except (ValueError, UnicodeDecodeError):
+            written = {}
+    for name in DEMO_FILES:
+        path = out / name
+        if path.exists() and (not path.is_file() or written.get(name) != _sha1(path)):
+            raise GfeInputError(str(path), None, "exists and is not as the demo wrote it; "
+                                "pass --force to overwrite it, or choose another --out")
+
+
+def _mark_demo_folder(out: Path) -> None:
+    import json
+
+    from .outputs import atomic_write
+
+    hashes = {name: _sha1(out / name) for name in DEMO_FILES if (out / name).is_file()}
+    atomic_write(out / MARKER, lambda tmp: Path(tmp).write_text(json.dumps(hashes, indent=1)))
+
+
 def run_demo(out: Path, force: bool = False) -> int:
     model_path, measured_path = out / "model.toml", out / "measured.json"
     updated_path, report_path = out / "updated.toml", out / "report.html"
-    existing = [p for p in (model_path, measured_path, updated_path, report_path)
-                if p.exists()]
-    if existing and not force:
-        raise GfeInputError(str(existing[0]), None,
-                            "exists already; pass --force to overwrite the demo's files")
+    if not force:
+        check_demo_folder(out)
     out.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(problem_file("ss-steel-beam.toml"), model_path)
     model = load_model(model_path)
@@ -67,6 +102,7 @@ def run_demo(out: Path, force: bool = False) -> int:
     best = diagnosis.best
     if best is None:
         print("\nNothing significant to add.")
+        _mark_demo_folder(out)
         return 0
     print(f"\n5. Add it: update --add {best.effect} fits its parameters, starting from the "
           "diagnosis.\n")
@@ -91,7 +127,8 @@ def run_demo(out: Path, force: bool = False) -> int:
     if figures is not None:
         _write_report(out, report_path, figures, result, diagnosis, outcome, best, model,
                       model_path, measured_path, updated_path)
-    print(f"\nFiles in {out}/. Reproduce with:\n"
+    _mark_demo_folder(out)
+    print(f"\nFiles in {out}/ (a second gfe-opt demo rewrites them). Reproduce with:\n"
           f"  gfe-opt compare {model_path} {measured_path}\n"
           f"  gfe-opt diagnose {model_path} {measured_path}\n"
           f"  gfe-opt update {model_path} {measured_path} --add {best.effect} "

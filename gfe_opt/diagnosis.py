@@ -327,11 +327,15 @@ def _run_jobs(jobs, progress, labels):
             raise
         pool.shutdown(wait=True)
     except (OSError, ValueError, BrokenProcessPool):
-        for i, job in enumerate(jobs):
-            if results[i] is None:
-                results[i] = _job(job)
-            if progress:
-                progress(i + 1, len(jobs), labels[i])
+        from threadpoolctl import threadpool_limits
+
+        # one BLAS thread, as in the workers: the same rounding, the same answer
+        with threadpool_limits(limits=1):
+            for i, job in enumerate(jobs):
+                if results[i] is None:
+                    results[i] = _job(job)
+                if progress:
+                    progress(i + 1, len(jobs), labels[i])
     return results
 
 

@@ -389,7 +389,11 @@ def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
     for i, m in enumerate(modes):
         if [int(n) for n in np.asarray(m["node_nums"]).astype(int)] != nodes:
             raise GfeInputError(where, f"dataset 55 #{i + 1}", "nodes differ from the first mode")
-        shapes.append(np.real(np.asarray(m[comp], dtype=complex)))
+        values = np.real(np.asarray(m[comp], dtype=complex)).ravel()
+        if values.size != len(nodes):
+            raise GfeInputError(where, f"dataset 55 #{i + 1}", f"{values.size} values for "
+                                f"{len(nodes)} nodes (a damaged record)")
+        shapes.append(values)
         freqs.append(float(m["freq"]))
         damping.append(float(m.get("modal_damp_vis", 0.0) or 0.0))
     # dataset 55 always has a damping field: zero everywhere means "not given"

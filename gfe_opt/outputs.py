@@ -47,8 +47,8 @@ def check_output_path(out, force: bool = False, inputs=(), kind: str | None = No
                             f"{' or '.join(FORMATS[kind])}, not {path.suffix or 'no extension'}")
     if exists:
         if not force:
-            raise GfeInputError(where, str(path), "exists already; pass --force to "
-                                "overwrite it")
+            raise GfeInputError(where, str(path), "exists already; pass --force "
+                                "(force=True from Python) to overwrite it")
     parent = path.parent
     while not parent.exists() and parent != parent.parent:
         parent = parent.parent

@@ -149,7 +149,9 @@ def candidate_errors(fits, baseline_pct, together=None):
     ax = fig.add_subplot()
     names = [f.effect for f in fits]
     values = [f.misfit.freq_error_rms_pct for f in fits]
-    colours = ["tab:green" if f.significant else "0.6" for f in fits]
+    # the effect found (the first significant one) green, others also significant pale
+    colours = ["tab:green" if f.significant and i == 0 else "#a6d8a6" if f.significant
+               else "0.6" for i, f in enumerate(fits)]
     hatches = [""] * len(fits)
     if together is not None:
         names.insert(0, " + ".join(e.name for e in together.effects[-2:]))
@@ -161,7 +163,8 @@ def candidate_errors(fits, baseline_pct, together=None):
         bar.set_hatch(hatch)
     ax.axvline(baseline_pct, color="tab:red", ls="--", lw=1, label="model as it stands")
     ax.set_xlabel("frequency error left [% rms]")
-    ax.set_title("Candidate effects (green: significant)")
+    ax.set_title("Candidate effects, best first (green: the effect found; pale green: also "
+                 "significant)", fontsize=9)
     ax.legend(fontsize=8)
     return fig
 

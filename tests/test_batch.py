@@ -165,6 +165,7 @@ def test_batch_input_errors_are_one_line(campaign, tmp_path, capsys):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and match in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty"]  # nothing left behind
 
 
 def test_trend_cli_draws_and_reports(campaign, tmp_path, capsys):

@@ -7,6 +7,7 @@ import sys
 import pytest
 
 from gfe_opt.cli import main
+from gfe_opt.demo import check_demo_folder
 from gfe_opt.measured import save_measured
 from gfe_opt.model import Effect, load_model
 from gfe_opt.problems import problem_file
@@ -75,8 +76,13 @@ def test_demo_tells_the_whole_story_and_refuses_to_overwrite(tmp_path, capsys):
     updated = load_model(out / "updated.toml")
     assert [e.name for e in updated.effects] == ["crack"]
     assert abs(updated.effects[0].parameters["position"] - 0.19) < 0.015
+    # a second demo rewrites its own files; one changed since, or not the demo's, is kept
+    check_demo_folder(out)
+    with open(out / "model.toml", "a") as handle:
+        handle.write("# my note\n")
     assert main(["demo", "--out", str(out)]) == 2
-    assert "--force" in capsys.readouterr().err
+    assert "model.toml: exists and is not as the demo wrote it" in capsys.readouterr().err
+    assert (out / "model.toml").read_text().endswith("# my note\n")
 
 
 def test_diagnose_json_contract(files, capsys):
