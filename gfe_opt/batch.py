@@ -390,9 +390,9 @@ def _execute(task, todo, scheduler, workers, progress, skipped):
             report(row)
             yield row
     except BaseException:
-        for process in list(getattr(pool, "_processes", {}).values()):
-            process.terminate()
-        pool.shutdown(wait=True, cancel_futures=True)
+        from .diagnosis import stop_pool
+
+        stop_pool(pool)
         raise
     pool.shutdown(wait=True)
 

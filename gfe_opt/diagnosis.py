@@ -320,10 +320,7 @@ def _run_jobs(jobs, progress, labels):
                 if progress:
                     progress(done, len(jobs), labels[futures[future]])
         except BaseException:
-            # Ctrl-C or a failure: no worker is left behind
-            for process in list(getattr(pool, "_processes", {}).values()):
-                process.terminate()
-            pool.shutdown(wait=True, cancel_futures=True)
+            stop_pool(pool)
             raise
         pool.shutdown(wait=True)
     except (OSError, ValueError, BrokenProcessPool):
@@ -337,6 +334,13 @@ def _run_jobs(jobs, progress, labels):
                 if progress:
                     progress(i + 1, len(jobs), labels[i])
     return results
+
+
+def stop_pool(pool) -> None:
+    """Ctrl-C or a failure: end every worker now (none is left behind) and the pool."""
+    for process in list(getattr(pool, "_processes", {}).values()):
+        process.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _single_threaded_blas():
