@@ -131,22 +131,10 @@ def load_frfs(paths, form: str | None = None) -> FRFs:
 
 
 def _read_uff58(path: Path) -> FRFs:
-    import pyuff
-
-    from .measured import _check_uff_complete
+    from .measured import read_uff_sets
 
     where = str(path)
-    _check_uff_complete(path)
-    try:
-        sets = pyuff.UFF(str(path)).read_sets()
-    except Exception as exc:  # pyuff raises bare Exceptions on malformed files
-        raise GfeInputError(where, None, f"not a readable UFF file ({exc})") from None
-    sets = [sets] if isinstance(sets, dict) else sets
-    coords = {}
-    for s in sets:
-        if s.get("type") in (15, 2411):
-            for n, xv in zip(np.asarray(s["node_nums"]).astype(int), s["x"]):
-                coords[int(n)] = float(xv)
+    sets, coords = read_uff_sets(path)
     frfs = [s for s in sets if s.get("type") == 58 and s.get("func_type") == 4]
     if not frfs:
         raise GfeInputError(where, "dataset 58", "no frequency response function "

@@ -353,25 +353,29 @@ def _check_uff_complete(path: Path) -> None:
                             "was it cut short?")
 
 
-def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
+def read_uff_sets(path: Path) -> tuple[list, dict]:
+    """The datasets of a universal file (pyuff) and its node x coordinates (datasets 15 and
+    2411); a file cut short or unreadable is one line."""
     import pyuff
 
-    where = str(path)
     _check_uff_complete(path)
     try:
         sets = pyuff.UFF(str(path)).read_sets()
     except Exception as exc:  # pyuff raises bare Exceptions on malformed files
-        raise GfeInputError(where, None, f"not a readable UFF file ({exc})") from None
-    if isinstance(sets, dict):
-        sets = [sets]
+        raise GfeInputError(str(path), None, f"not a readable UFF file ({exc})") from None
+    sets = [sets] if isinstance(sets, dict) else sets
     coords = {}
-    modes = []
     for s in sets:
         if s.get("type") in (15, 2411):
             for n, x in zip(np.asarray(s["node_nums"]).astype(int), s["x"]):
                 coords[int(n)] = float(x)
-        elif s.get("type") == 55 and s.get("analysis_type") == 2:
-            modes.append(s)
+    return sets, coords
+
+
+def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
+    where = str(path)
+    sets, coords = read_uff_sets(path)
+    modes = [s for s in sets if s.get("type") == 55 and s.get("analysis_type") == 2]
     if not coords:
         raise GfeInputError(where, "dataset 15/2411", "no node coordinates found")
     if not modes:
