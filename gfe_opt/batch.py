@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import io
 import json
 import math
 import os
@@ -195,11 +196,9 @@ def write_table(rows, path) -> None:
     from .outputs import atomic_write
 
     path = Path(path)
-    rows = sorted(rows, key=lambda r: r["file"])
+    rows = sorted((_plain(r) for r in rows), key=lambda r: r["file"])
     names = columns_of(rows)
     if path.suffix.lower() == ".parquet":
-        import io
-
         import pyarrow as pa
         import pyarrow.parquet as pq
 
@@ -218,8 +217,6 @@ def write_table(rows, path) -> None:
         data = buffer.getvalue()
         atomic_write(path, lambda tmp: Path(tmp).write_bytes(data))
     else:
-        import io
-
         text = io.StringIO()
         writer = csv.writer(text, lineterminator="\n")
         writer.writerow(names)
@@ -332,7 +329,8 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
     try:
         with open(journal, "a", encoding="utf-8") as log:
             for row in _execute(task, todo, scheduler, workers, progress, skipped):
-                log.write(json.dumps(row, allow_nan=False, default=_json_default) + "\n")
+                row = _plain(row)
+                log.write(json.dumps(row, allow_nan=False) + "\n")
                 log.flush()
                 os.fsync(log.fileno())
                 new_rows.append(row)
@@ -348,17 +346,20 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
                        time.perf_counter() - start, out)
 
 
-def _json_default(value):
-    return None
+def _plain(row: dict) -> dict:
+    """A row with non-finite numbers as None (JSON, Parquet and CSV nulls) and numpy
+    scalars as Python numbers."""
+    out = {}
+    for k, v in row.items():
+        if hasattr(v, "item") and not isinstance(v, (str, bytes)):
+            v = v.item()
+        out[k] = None if isinstance(v, float) and not math.isfinite(v) else v
+    return out
 
 
 def _clean(rows):
-    """NaN as None (Parquet and CSV nulls), one row per file (the newest)."""
-    latest = {}
-    for row in rows:
-        latest[row["file"]] = {k: (None if isinstance(v, float) and not math.isfinite(v)
-                                   else v) for k, v in row.items()}
-    return list(latest.values())
+    """Plain rows, one per file (the newest)."""
+    return list({row["file"]: _plain(row) for row in rows}.values())
 
 
 def _execute(task, todo, scheduler, workers, progress, skipped):

@@ -183,3 +183,18 @@ def test_trend_cli_draws_and_reports(campaign, tmp_path, capsys):
     assert data["sets"] == N_SETS and [o["effect"] for o in data["onsets"]] == ["crack"]
     assert main(argv) == 2  # figures exist: not overwritten without --force
     assert "exists" in capsys.readouterr().err
+
+
+def test_rows_with_nan_and_numpy_numbers_are_written_as_nulls(tmp_path):
+    # a set with no paired mode has a NaN frequency error; numpy scalars come from the fits
+    from gfe_opt.batch import _plain, write_table
+
+    row = {"file": "a.json", "sha1": "0", "status": "ok", "freq_error_after_pct": float("nan"),
+           "crack.depth_ratio": np.float64(0.25), "crack.depth_ratio.sigma": np.inf}
+    line = json.dumps(_plain(row), allow_nan=False)
+    assert json.loads(line)["freq_error_after_pct"] is None
+    for name in ("t.parquet", "t.csv"):
+        write_table([row], tmp_path / name)
+        back = read_table(tmp_path / name)[0]
+        assert back["freq_error_after_pct"] is None and back["crack.depth_ratio.sigma"] is None
+        assert back["crack.depth_ratio"] == 0.25
