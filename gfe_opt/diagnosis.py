@@ -556,8 +556,9 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         if band is not None and found is not None:
             band = explain(band, _discretise(model), _discretise(found.model), measured,
                            noise)
-        words = (describe_profile(band, found.name if found else None) if band is not None
-                 else [])
+        words = (describe_profile(band, found.name if found else None,
+                                  found is not None and explains(found))
+                 if band is not None else [])
     estimate = _noise_estimate(model, measured, noise, [*ranked, reference, together], C,
                                ref_misfit,
                                sel.floor)

@@ -48,24 +48,43 @@ def parameter_changes(curves, *, quantity: str, title: str, crack_position=None)
     return fig
 
 
-def profile_with_band(band, label=None):
-    """The generic update's k_i / k_i0 along the structure with its ±3σ noise band and, when
-    an effect was found, what the update reads from that effect's own modes."""
-    fig = _figure()
-    ax = fig.add_subplot()
+def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pinned"),
+                      places=(), findings=()):
+    """The generic update's k_i / k_i0 along the structure with its ±3σ noise band, the
+    features beyond it labelled, and, when an effect was found, what the update reads
+    from that effect's own modes; below, the structure with the located place and the
+    fitted effects (``findings`` as for :func:`structure_sketch`)."""
+    fig = _figure(7.0, 4.6 if length is not None else 3.6)
+    if length is not None:
+        ax, sketch = fig.subplots(2, 1, sharex=True, height_ratios=(3.4, 1.1))
+    else:
+        ax, sketch = fig.add_subplot(), None
     x = band.x
     ok = np.isfinite(band.sigma)
-    ax.fill_between(x[ok], (1 - 3 * band.sigma)[ok], (1 + 3 * band.sigma)[ok], color="0.85",
-                    label="noise band (±3σ)")
-    ax.plot(x, band.ratio, "o-", ms=3, color="tab:blue", label="generic update of the data")
+    ax.fill_between(x[ok], (1 - 3 * band.sigma)[ok], (1 + 3 * band.sigma)[ok], color="0.87",
+                    label="what noise alone gives (±3σ)")
+    ax.plot(x, band.ratio, "o-", ms=3, color="tab:blue", label="generic update of the test")
     if band.explained is not None:
         ax.plot(x, band.explained, "--", color="tab:red",
-                label=f"... of the fitted {label}'s modes")
+                label=f"the same, of the fitted {label}'s modes")
+    for f in band.features:
+        if f.kind not in ("loss", "rise"):
+            continue
+        grey = f in band.unexplained and band.explained is not None
+        ax.annotate(f"{f.value:.2f}±{f.sigma:.2f}", (f.x, f.value), textcoords="offset points",
+                    xytext=(0, -12 if f.kind == "loss" else 6), ha="center", fontsize=7,
+                    color="0.45" if grey else "black")
     ax.axhline(1.0, color="0.4", lw=0.8)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("$k_i / k_{i,0}$")
-    ax.set_title("Generic-element update: nodal bending stiffness over the model's")
-    ax.legend(fontsize=8)
+    ax.margins(y=0.12)
+    ax.set_ylabel("$k_i / k_{i,0}$ (1 = as modelled)")
+    ax.set_title("Bending stiffness read from the test at each node, over the model's",
+                 fontsize=10)
+    ax.legend(fontsize=7, loc="lower right")
+    if sketch is not None:
+        structure_sketch(sketch, length, supports, places=places, findings=findings)
+        sketch.set_xlabel("x [m]")
+    else:
+        ax.set_xlabel("x [m]")
     return fig
 
 
@@ -85,64 +104,109 @@ def disturbance_function(x_nodes, q_identified, x_fine, q_exact, *, label_exact:
 
 
 def mac_matrix(mac, pairs=()):
-    """MAC heat map (test modes down, model modes across) with the values in the cells."""
+    """MAC heat map, test modes down and model modes across, with the values in the cells.
+    Only the model modes up to the highest paired one are drawn (the rest are computed to
+    pair against, and would fill the figure with zeros)."""
     mac = np.asarray(mac)
-    fig = _figure(1.0 + 0.55 * mac.shape[1], 1.0 + 0.5 * mac.shape[0])
+    pairs = set(pairs)
+    shown = max([j for _, j in pairs], default=mac.shape[1] - 1) + 1
+    shown = min(max(shown, mac.shape[0]), mac.shape[1])
+    cropped = mac[:, :shown]
+    fig = _figure(1.6 + 0.6 * shown, 1.0 + 0.5 * mac.shape[0])
     ax = fig.add_subplot()
-    image = ax.imshow(mac, vmin=0.0, vmax=1.0, cmap="viridis")
-    for (i, j), value in np.ndenumerate(mac):
+    image = ax.imshow(cropped, vmin=0.0, vmax=1.0, cmap="viridis")
+    for (i, j), value in np.ndenumerate(cropped):
         ax.text(j, i, f"{value:.2f}", ha="center", va="center", fontsize=7,
                 color="black" if value > 0.6 else "white",
-                fontweight="bold" if (i, j) in set(pairs) else "normal")
-    ax.set_xticks(range(mac.shape[1]), [str(j + 1) for j in range(mac.shape[1])])
+                fontweight="bold" if (i, j) in pairs else "normal")
+    ax.set_xticks(range(shown), [str(j + 1) for j in range(shown)])
     ax.set_yticks(range(mac.shape[0]), [str(i + 1) for i in range(mac.shape[0])])
-    ax.set_xlabel("model mode")
+    more = f" (of {mac.shape[1]} computed)" if shown < mac.shape[1] else ""
+    ax.set_xlabel(f"model mode{more}")
     ax.set_ylabel("test mode")
-    ax.set_title("MAC (pairs in bold)")
-    fig.colorbar(image, ax=ax, shrink=0.8)
+    ax.set_title("MAC: 1 = same shape (pairs in bold)", fontsize=10)
+    fig.colorbar(image, ax=ax, shrink=0.8, label="MAC")
     return fig
 
 
 def paired_frequencies(pairs):
-    """Test and model frequencies of the pairs, and their errors in %."""
+    """Test and model frequencies of the pairs (log scale: modes spread over decades) and
+    the model's error in % per pair, signed and labelled."""
     fig = _figure(7.0, 3.4)
     left, right = fig.subplots(1, 2)
     modes = [p.test_mode for p in pairs]
-    left.plot(modes, [p.test_hz for p in pairs], "o-", label="test")
-    left.plot(modes, [p.model_hz for p in pairs], "s--", label="model")
+    left.semilogy(modes, [p.test_hz for p in pairs], "o-", label="test")
+    left.semilogy(modes, [p.model_hz for p in pairs], "s--", mfc="none", label="model")
     left.set_xlabel("test mode")
     left.set_ylabel("frequency [Hz]")
+    left.set_xticks(modes)
     left.legend(fontsize=8)
-    right.bar(modes, [p.error_pct for p in pairs], color="tab:red")
+    left.set_title("Paired frequencies", fontsize=10)
+    errors = [p.error_pct for p in pairs]
+    colours = ["tab:red" if e > 0 else "tab:blue" for e in errors]
+    right.bar(modes, errors, color=colours)
+    for m, e in zip(modes, errors):
+        right.annotate(f"{e:+.2f}", (m, e), textcoords="offset points",
+                       xytext=(0, 3 if e >= 0 else -10), ha="center", fontsize=7)
     right.axhline(0.0, color="0.5", lw=0.8)
+    right.set_xticks(modes)
     right.set_xlabel("test mode")
-    right.set_ylabel("Δf [%]")
-    right.set_title("model − test")
+    right.set_ylabel(r"$(f_\mathrm{model} - f_\mathrm{test}) / f_\mathrm{test}$ [%]")
+    right.set_title("Model error (red: model too stiff)", fontsize=10)
+    right.margins(y=0.15)
     return fig
 
 
-def localisation(x, residual, comac, length, supports=("pinned", "pinned")):
-    """Residual force and COMAC along the structure, with the structure drawn below."""
-    fig = _figure(7.0, 4.2)
-    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))
-    top.plot(x, residual / max(np.max(residual), 1e-300), "o-", ms=3, label="residual force")
-    top.plot(x, comac, "s-", ms=3, label="COMAC")
-    top.set_ylabel("relative value")
-    top.set_ylim(-0.05, 1.1)
-    top.legend(fontsize=8)
-    top.set_title("Where the model fails")
-    bottom.plot([0, length], [0, 0], lw=6, color="0.4", solid_capstyle="butt")
-    bottom.plot(x, np.zeros_like(x), "v", color="tab:blue", ms=4, label="sensors")
+def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None, places=(),
+                     findings=()):
+    """The structure as a bar on ``ax`` (x in m): its supports, the sensors, where the model
+    fails (``places``: (x, share of the largest residual)) and ``findings``: (effect type,
+    model, parameters, σ) each drawn by the effect's own ``mark``."""
+    ax.plot([0, length], [0, 0], lw=6, color="0.4", solid_capstyle="butt")
+    if sensors is not None and len(sensors):
+        ax.plot(sensors, np.zeros_like(np.asarray(sensors, float)), "|", color="white",
+                ms=5, mew=1, label="sensors")
     for end, kind in zip((0.0, length), supports):
-        bottom.annotate(kind, (end, 0), textcoords="offset points", xytext=(0, -14),
-                        ha="center", fontsize=7)
-    bottom.set_yticks([])
-    bottom.set_ylim(-1, 1)
+        ax.annotate(kind, (end, 0), textcoords="offset points", xytext=(0, -16),
+                    ha="center", fontsize=7)
+    for k, (x, _) in enumerate(places):  # the largest labelled, the others marked
+        ax.plot([x], [-0.35], marker="^", color="tab:purple", ms=9 if k == 0 else 5,
+                alpha=1.0 if k == 0 else 0.6)
+        if k == 0:
+            ax.annotate(f"model fails most: x = {x:.3f} m", (x, -0.35),
+                        textcoords="offset points", xytext=(0, -12), ha="center", fontsize=7,
+                        color="tab:purple")
+    for k, (effect, model, params, sigma) in enumerate(findings):  # a pair on two levels
+        effect.mark(ax, model, params, sigma, 0.35 + 0.5 * k)
+    ax.set_yticks([])
+    ax.set_ylim(-1.2, 1.2)
+    ax.set_xlim(-0.04 * length, 1.04 * length)
+    for side in ("left", "right", "top"):
+        ax.spines[side].set_visible(False)
+
+
+def localisation(x, residual, comac, length, supports=("pinned", "pinned"), places=()):
+    """Where the model fails: the residual force (high is bad) and the COMAC (1 is good) on
+    axes of their own, the structure below with the sensors and the located places."""
+    fig = _figure(7.0, 5.0)
+    top, middle, bottom = fig.subplots(3, 1, sharex=True, height_ratios=(3, 1.6, 1.2))
+    top.plot(x, residual / max(np.max(residual), 1e-300), "o-", ms=3, color="tab:purple")
+    top.set_ylabel("residual force\n(largest = 1)")
+    top.set_ylim(-0.05, 1.1)
+    if len(places):
+        top.axvline(places[0][0], color="tab:purple", lw=0.8, ls=":")
+    top.set_title("Where the model fails: high residual force = the model's equations of "
+                  "motion do not hold", fontsize=9)
+    middle.plot(x, comac, "s-", ms=3, color="tab:green")
+    middle.set_ylabel("COMAC\n(1 = shapes agree)")
+    low = float(np.min(comac)) if len(comac) else 0.0
+    middle.set_ylim(min(low, 0.9) - 0.02, 1.01)
+    structure_sketch(bottom, length, supports, sensors=x, places=places)
     bottom.set_xlabel("x [m]")
     return fig
 
 
-def candidate_errors(fits, baseline_pct, together=None):
+def candidate_errors(fits, baseline_pct, together=None, verdict=None):
     """Frequency error left by each candidate effect (significant ones coloured) and, when
     a pair is suggested, by the pair (hatched, on top)."""
     fig = _figure(7.0, 3.2)
@@ -163,8 +227,13 @@ def candidate_errors(fits, baseline_pct, together=None):
         bar.set_hatch(hatch)
     ax.axvline(baseline_pct, color="tab:red", ls="--", lw=1, label="model as it stands")
     ax.set_xlabel("frequency error left [% rms]")
-    ax.set_title("Candidate effects, best first (green: the effect found; pale green: also "
-                 "significant)", fontsize=9)
+    for bar, value in zip(bars, values[::-1]):
+        ax.annotate(f"{value:.3g} %", (value, bar.get_y() + bar.get_height() / 2),
+                    textcoords="offset points", xytext=(3, 0), va="center", fontsize=7)
+    ax.set_title("best first; green: the effect found, pale green: significant but not "
+                 "the answer", fontsize=8)
+    if verdict:
+        fig.suptitle(f"verdict: {verdict}", fontsize=10, fontweight="bold")
     ax.legend(fontsize=8)
     return fig
 
@@ -182,19 +251,56 @@ def error_history(steps):
     return fig
 
 
-def nodal_coefficients(realisations):
-    """The continuous-equation coefficients per node (k/k0, m/m0, tension, foundation)."""
-    fig = _figure(7.0, 4.0)
-    top, bottom = fig.subplots(2, 1, sharex=True)
+def nodal_coefficients(realisations, bending_rigidity=None, length=None):
+    """The continuous-equation coefficients read at each node, one quantity per panel: the
+    stiffness and mass ratios (1 = the model's), the axial force T and the foundation
+    stiffness k_f, each against the scale that would matter physically (the Euler load
+    π²EI/L², and EI(π/L)⁴, the foundation that doubles f₁² of a pinned beam) when the
+    bending rigidity and length are given."""
+    fig = _figure(7.0, 5.4)
+    top, middle, bottom = fig.subplots(3, 1, sharex=True)
     x = [r.x for r in realisations]
-    top.plot(x, [r.k_ratio for r in realisations], "o-", ms=3, label="k / k0 (w'''')")
-    top.plot(x, [r.mass_ratio for r in realisations], "s-", ms=3, label="m / m0 (ẅ)")
-    top.legend(fontsize=8)
-    top.set_title("Continuous equation at each node")
-    bottom.plot(x, [r.tension for r in realisations], "o-", ms=3, label="T [N] (−T w'')")
-    bottom.plot(x, [r.foundation for r in realisations], "s-", ms=3, label="k_f [N/m²] (w)")
+    top.plot(x, [r.k_ratio for r in realisations], "o-", ms=3,
+             label="$k/k_0$: coefficient of $w''''$")
+    top.plot(x, [r.mass_ratio for r in realisations], "s-", ms=3,
+             label=r"$m/m_0$: coefficient of $\ddot w$")
+    top.axhline(1.0, color="0.5", lw=0.8)
+    top.set_ylabel("ratio to the model")
+    top.legend(fontsize=7)
+    top.set_title(r"What each node's updated equation says: "
+                  r"$(k\,w'')'' - T\,w'' + k_f\,w + m\,\ddot w = 0$", fontsize=10)
+    middle.plot(x, np.array([r.tension for r in realisations]) / 1e3, "o-", ms=3,
+                color="tab:brown")
+    middle.set_ylabel("axial force\n$T$ [kN]")
+    bottom.plot(x, np.array([r.foundation for r in realisations]) / 1e6, "s-", ms=3,
+                color="tab:olive")
+    bottom.set_ylabel("foundation\n$k_f$ [MN/m²]")
+    if bending_rigidity is not None and length is not None:
+        euler = np.pi**2 * bending_rigidity / length**2 / 1e3
+        double = bending_rigidity * (np.pi / length) ** 4 / 1e6
+        for ax, scale, text in ((middle, euler, r"± Euler load $\pi^2EI/L^2$"),
+                                (bottom, double, r"± $EI(\pi/L)^4$ (doubles $f_1^2$)")):
+            for sign in (1, -1):
+                ax.axhline(sign * scale, color="0.5", ls="--", lw=0.8,
+                           label=text if sign > 0 else None)
+            ax.legend(fontsize=7, loc="upper right")
+    from .realisation import uniform_term
+
+    for ax, values, unit, scale in (
+            (middle, [r.tension for r in realisations], "kN", 1e3),
+            (bottom, [r.foundation for r in realisations], "MN/m²", 1e6)):
+        ax.axhline(0.0, color="0.7", lw=0.8)
+        level = uniform_term(values)
+        if not np.any(np.abs(values) > 0):
+            text = "zero at every node"
+        elif level:
+            text = f"one value along the beam: {level / scale:.4g} {unit}"
+        else:
+            text = ("no value common to the beam: node-to-node scatter (k'' and noise), "
+                    "not a physical term")
+        ax.text(0.01, 0.9, text, transform=ax.transAxes, fontsize=7, color="0.3", va="top",
+                bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
     bottom.set_xlabel("x [m]")
-    bottom.legend(fontsize=8)
     return fig
 
 

@@ -219,8 +219,8 @@ def summarise(realisations: list[Realisation]) -> list[str]:
     local ones by their extreme node)."""
     k = np.array([r.k_ratio for r in realisations])
     m = np.array([r.mass_ratio for r in realisations])
-    tension = _uniform([r.tension for r in realisations])
-    foundation = _uniform([r.foundation for r in realisations])
+    tension = uniform_term([r.tension for r in realisations])
+    foundation = uniform_term([r.foundation for r in realisations])
     lines = []
     if abs(np.median(k) - 1) > 5e-3:
         lines.append(f"uniform bending stiffness {np.median(k):.3f} k0 (a material change)")
@@ -239,7 +239,7 @@ def summarise(realisations: list[Realisation]) -> list[str]:
     return lines
 
 
-def _uniform(values) -> float:
+def uniform_term(values) -> float:
     """The median of a term that is present along the whole beam with one sign and a small
     spread (80 % of the nodes, interquartile range below half the median), else 0."""
     v = np.asarray(values, float)
@@ -285,8 +285,10 @@ class Feature:
             return (f"EI tapers from {self.start:.3f} of the model's at the left end to "
                     f"{self.value:.3f} at the right end (± {self.sigma:.3f}): a taper")
         word = "loss" if self.kind == "loss" else "rise"
-        return (f"a local stiffness {word} near x = {self.x:.3f} m ({self.x_from:.3f} to "
-                f"{self.x_to:.3f} m): k = {self.value:.2f} ± {self.sigma:.2f} of the model's")
+        extent = ("at one node" if self.x_from == self.x_to else
+                  f"{self.x_from:.3f} to {self.x_to:.3f} m")
+        return (f"a local stiffness {word} near x = {self.x:.3f} m ({extent}): "
+                f"k = {self.value:.2f} ± {self.sigma:.2f} of the model's")
 
 
 @dataclass(frozen=True)
@@ -491,16 +493,21 @@ def _features(x, ratio, sigma, n_modes):
     return trend, [f for _, f in features[:3]]
 
 
-def describe_profile(band: ProfileBand, effect: str | None = None) -> list[str]:
+def describe_profile(band: ProfileBand, effect: str | None = None,
+                     explains_test: bool = False) -> list[str]:
     """The generic update in words: every significant feature one sentence; with
-    ``effect`` (the effect found, after :func:`explain`) which of them it explains."""
+    ``effect`` (the effect found, after :func:`explain`) which of them it explains.  When
+    that effect brings the whole misfit to the noise (``explains_test``), a feature it does
+    not reproduce is no evidence of anything else, and is said to be none."""
     if not band.features:
         finite = band.sigma[np.isfinite(band.sigma)]
         width = 100 * FEATURE_SIGMAS * float(np.median(finite)) if finite.size else 0.0
         return [f"no change of the bending stiffness beyond the noise band (±{width:.1f} %)"]
     if effect is None or band.explained is None:
         return [f.describe() for f in band.features]
-    return [f"{f.describe()}" + (f" (not reproduced by the fitted {effect})"
-                                   if f in band.unexplained else
-                                   f" (the fitted {effect} reproduces it)")
+    lobe = (f" (not reproduced by the fitted {effect}; with the {effect} the test fits to "
+            "the noise, so this is the update's ringing, not a finding)" if explains_test
+            else f" (not reproduced by the fitted {effect})")
+    return [f.describe() + (lobe if f in band.unexplained else
+                            f" (the fitted {effect}'s own modes show it too)")
             for f in band.features]

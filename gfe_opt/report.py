@@ -21,26 +21,50 @@ def compare_figures(result, model) -> dict:
         "mac.png": plots.mac_matrix(result.mac_matrix, pairs),
         "frequencies.png": plots.paired_frequencies(result.pairs),
         "localisation.png": plots.localisation(result.sensor_x, result.residual, result.comac,
-                                               model.length, model.supports),
+                                               model.length, model.supports,
+                                               places=result.failure_places()),
     }
+
+
+def findings(diagnosis, model) -> list:
+    """The effects a diagnosis found, as (effect type, model, parameters, σ) for the
+    structure sketch: the suggested pair when there is one, else the effect found."""
+    fit = diagnosis.together or diagnosis.best
+    if fit is None:
+        return []
+    held = len(model.effects)
+    return [(effect_type(e.name), model, e.parameters, s)
+            for e, s in zip(fit.effects[held:], fit.sigma[held:])]
+
+
+def verdict_title(diagnosis) -> str:
+    """``crack missing``, ``consistent with the test`` or ``nothing known explains it``."""
+    if diagnosis.verdict == "effect_found":
+        return " + ".join(diagnosis.suggested) + " missing"
+    return {"consistent": "consistent with the test within the noise",
+            "unexplained": "no known effect explains the difference"}[diagnosis.verdict]
 
 
 def diagnosis_figures(diagnosis, model) -> dict:
     """Candidate errors; with the generic update: its stiffness profile against the noise
-    band and what the effect found would show, the nodal equation coefficients and (for a
-    crack) the identified Q_i against Christides–Barr Q(x)."""
+    band and what the effect found would show, the structure with the located place and
+    the fitted effects, the nodal equation coefficients and (for a crack) the identified
+    Q_i against Christides–Barr Q(x)."""
     figs = {"candidates.png": plots.candidate_errors(
-        diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together)
-            } if diagnosis.fits else {}
+        diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
+        verdict=verdict_title(diagnosis))} if diagnosis.fits else {}
     band = diagnosis.profile_band
     best = diagnosis.best
     if band is not None:
         figs["stiffness_change.png"] = plots.profile_with_band(
-            band, label=best.name if best else None)
+            band, label=best.name if best else None, length=model.length,
+            supports=model.supports, places=diagnosis.localisation or (),
+            findings=findings(diagnosis, model))
         if best is not None:
             figs.update(effect_type(best.name).figures(model, best.parameters, band))
     if diagnosis.nodal:
-        figs["nodal_equations.png"] = plots.nodal_coefficients(diagnosis.nodal)
+        figs["nodal_equations.png"] = plots.nodal_coefficients(
+            diagnosis.nodal, model.bending_rigidity, model.length)
     return figs
 
 

@@ -121,8 +121,12 @@ def format_diagnosis(result, model) -> str:
                                                        result.localisation)
                  if result.localisation else "where it fails is unknown without mode shapes")
         lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 fits to the noise); {where}")
-    for word in result.realisation:
-        lines.append(f"the generic-element update (nodal k_i): {word}")
+    words = list(result.realisation)
+    if len(words) == 1 and words[0].startswith("the generic-element update"):
+        lines.append(words[0])
+    elif words:
+        lines.append("the generic-element update (nodal k_i, no physical effect assumed):")
+        lines += [f"  - {word}" for word in words]
     lines += [f"note: {n}" for n in result.notes]
     lines.append(f"({result.seconds:.1f} s)")
     return "\n".join(lines)

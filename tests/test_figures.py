@@ -33,18 +33,36 @@ def _lines(ax):
     return [len(line.get_xdata()) for line in ax.get_lines()]
 
 
+def _marks_at(ax, x):
+    """Single-point markers drawn on ``ax`` at abscissa ``x``."""
+    return [line for line in ax.get_lines() if len(line.get_xdata()) == 1
+            and np.isclose(line.get_xdata()[0], x)]
+
+
 def test_compare_figures_show_the_data(case):
     model, measured, _ = case
     result = compare(model, measured)
     figs = compare_figures(result, model)
     mac_ax = figs["mac.png"].axes[0]
-    assert mac_ax.images[0].get_array().shape == result.mac_matrix.shape
-    assert len(mac_ax.texts) == result.mac_matrix.size
+    # the paired model modes only: as many columns as the highest paired model mode
+    shown = max(p.model_mode for p in result.pairs)
+    assert shown < result.mac_matrix.shape[1]
+    assert mac_ax.images[0].get_array().shape == (measured.n_modes, shown)
+    bold = {(round(t.get_position()[1]), round(t.get_position()[0])) for t in mac_ax.texts
+            if t.get_fontweight() == "bold"}
+    assert bold == {(p.test_mode - 1, p.model_mode - 1) for p in result.pairs}
     left, right = figs["frequencies.png"].axes
-    assert _lines(left) == [len(result.pairs)] * 2 and len(right.patches) == len(result.pairs)
-    top = figs["localisation.png"].axes[0]
-    assert _lines(top) == [measured.n_sensors] * 2
-    assert figs["localisation.png"].axes[1].get_xlabel() == "x [m]"
+    assert left.get_yscale() == "log"  # modes spread over decades
+    assert _lines(left) == [len(result.pairs)] * 2
+    assert np.allclose([b.get_height() for b in right.patches],
+                       [p.error_pct for p in result.pairs])
+    residual, comac, sketch = figs["localisation.png"].axes
+    assert _lines(residual)[0] == measured.n_sensors and max(residual.get_lines()[0]
+                                                             .get_ydata()) == 1.0
+    assert _lines(comac) == [measured.n_sensors]
+    assert comac.get_ylim()[1] <= 1.01  # COMAC on its own axis, 1 at the top
+    assert _marks_at(sketch, result.failure_places()[0][0])  # the located place
+    assert sketch.get_xlabel() == "x [m]"
 
 
 def test_diagnosis_and_update_figures(case):
@@ -53,12 +71,20 @@ def test_diagnosis_and_update_figures(case):
     figs = diagnosis_figures(result, model)
     assert set(figs) == {"candidates.png", "stiffness_change.png", "disturbance.png",
                          "nodal_equations.png"}
-    assert len(figs["candidates.png"].axes[0].patches) == len(result.fits)
+    candidates = figs["candidates.png"].axes[0]
+    assert len(candidates.patches) == len(result.fits)
+    assert candidates.figure.get_suptitle() == "verdict: crack missing"
     n = model.elements
+    profile, sketch = figs["stiffness_change.png"].axes
     # the generic update, what the fitted crack's own modes give, the level 1
-    assert _lines(figs["stiffness_change.png"].axes[0]) == [n + 1, n + 1, 2]
+    assert _lines(profile) == [n + 1, n + 1, 2]
+    # the fitted crack marked on the structure where it was found, and the located place
+    assert _marks_at(sketch, result.best.parameters["position"])
+    assert _marks_at(sketch, result.localisation[0][0])
     assert _lines(figs["disturbance.png"].axes[0]) == [2000, n + 1]
-    assert all(length == n - 1 for length in _lines(figs["nodal_equations.png"].axes[0]))
+    ratios, tension, foundation = figs["nodal_equations.png"].axes
+    assert all(length == n - 1 for length in _lines(ratios)[:2])
+    assert "[kN]" in tension.get_ylabel() and "[MN/m²]" in foundation.get_ylabel()
     outcome = update(model, measured, ["crack"], **NOISE)
     bars = update_figures(outcome)["error.png"].axes[0].patches
     assert len(bars) == 2 and bars[1].get_height() < bars[0].get_height()

@@ -350,8 +350,9 @@ class EffectType:
 
     def mark(self, ax, model, params: dict, sigma: dict | None, y: float) -> None:
         """Draw the effect on the structure sketch (a matplotlib axis, x in m) at height y;
-        default: the name at mid-span for global effects."""
-        ax.annotate(self.name, (model.length / 2, y), textcoords="offset points",
+        default: the name and the fitted values at mid-span for global effects."""
+        ax.annotate(f"{self.name}: {self.describe(params, sigma)}", (model.length / 2, y),
+                    textcoords="offset points",
                     xytext=(0, 8), ha="center", fontsize=7, color="tab:red")
 
     def position(self, params: dict) -> float | None:

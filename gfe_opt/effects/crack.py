@@ -70,8 +70,9 @@ class Crack(EffectType):
         s = (sigma or {}).get("position")
         if s is not None and np.isfinite(s):
             ax.errorbar([x], [y], xerr=[2 * s], color="tab:red", capsize=3, lw=1)
-        ax.annotate(f"crack a/d {params['depth_ratio']:.2f}", (x, y), textcoords="offset "
-                    "points", xytext=(0, 9), ha="center", fontsize=7, color="tab:red")
+        ax.annotate(f"crack a/d {params['depth_ratio']:.2f} at {x:.3f} m", (x, y),
+                    textcoords="offset points", xytext=(0, 9), ha="center", fontsize=7,
+                    color="tab:red")
 
 
 EFFECT = Crack()
