@@ -212,8 +212,7 @@ def _write_outputs(args, figs, fill_report, title) -> None:
     if args.report:
         report = Report(title)
         fill_report(report)
-        for name, fig in figs.items():
-            report.figure(fig, name.removesuffix(".png").replace("_", " "))
+        report.figures(figs)
         report.heading("Reproduce")
         report.preformatted(" ".join(["gfe-opt", *args.argv]))
         report.save(args.report)

@@ -81,6 +81,31 @@ def save_figures(figs: dict, folder) -> list[Path]:
     return [plots.save(fig, Path(folder) / name) for name, fig in figs.items()]
 
 
+#: The question each figure answers (its caption in reports; the README's table says more).
+FIGURE_QUESTIONS = {
+    "mac.png": "Which model mode is which test mode? MAC, pairs in bold.",
+    "frequencies.png": "How far off is each frequency? Paired frequencies and the signed "
+                       "error of each.",
+    "localisation.png": "Where does the model fail? Residual force and COMAC per sensor, "
+                        "the place marked on the structure.",
+    "candidates.png": "Which effect is missing? The error each candidate leaves, best first.",
+    "stiffness_change.png": "How does the structure differ, with no effect assumed? The "
+                            "generic update's stiffness against what noise alone gives, and "
+                            "the fitted effects on the structure.",
+    "disturbance.png": "Is it a crack? Identified Q_i against Christides–Barr Q(x).",
+    "nodal_equations.png": "What does each node's updated equation say? Stiffness and mass "
+                           "ratios, axial force, foundation.",
+    "error.png": "Did the error fall? Frequency error before and after.",
+    "stabilisation.png": "Which poles are modes? Stable poles per model order.",
+    "trend.png": "How do the parameters move over the campaign? ±1σ bands, onsets marked.",
+}
+
+
+def caption(name: str) -> str:
+    """The caption of figure file ``name``: its question, or its name."""
+    return FIGURE_QUESTIONS.get(name, name.removesuffix(".png").replace("_", " "))
+
+
 class Report:
     """A self-contained HTML page: headings, text, tables, figures, commands."""
 
@@ -104,6 +129,11 @@ class Report:
                        + "</tr>" for row in rows)
         self.parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
 
+    def figures(self, figs: dict) -> None:
+        """Every figure of ``figs`` (file name -> figure), captioned with its question."""
+        for name, fig in figs.items():
+            self.figure(fig, caption(name))
+
     def figure(self, fig, caption: str) -> None:
         buffer = io.BytesIO()
         fig.savefig(buffer, format="png", dpi=110)
@@ -117,7 +147,8 @@ class Report:
         style = ("body{font-family:sans-serif;max-width:60em;margin:2em auto;color:#222}"
                  "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 8px;"
                  "text-align:right}th{background:#eee}img{max-width:100%}"
-                 "pre{background:#f6f6f6;padding:.5em;overflow-x:auto}")
+                 "pre{background:#f6f6f6;padding:.5em;white-space:pre-wrap}"
+                 "figcaption{color:#444;font-style:italic}")
         return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"/>"
                 f"<title>{html.escape(self.title)}</title><style>{style}</style></head>"
                 f"<body><h1>{html.escape(self.title)}</h1>{''.join(self.parts)}</body></html>\n")

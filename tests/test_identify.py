@@ -169,3 +169,24 @@ def test_bad_frf_inputs_are_one_line(tmp_path, capsys):
     (tmp_path / "short.csv").write_text("f,0.1,0.2\n1,1+1j,2\n2,1\n")
     _fails(capsys, ["identify", str(tmp_path / "short.csv"), "--out", out], "row 3")
     assert not (tmp_path / "m.json").exists()
+
+
+def test_shipped_frfs_identify_and_diagnose_to_the_crack(tmp_path, capsys):
+    """The README's loop on problems/demo-frf.uff: FRFs of the cracked beam simulated on the
+    independent reference beam (crack at 0.19 m, a/d 0.5; scripts/make_examples.py) ->
+    identify -> diagnose finds that crack, within 3σ and within 2 mm."""
+    from gfe_opt.diagnosis import diagnose
+    from gfe_opt.model import load_model
+    from gfe_opt.problems import problem_file
+
+    out = tmp_path / "modes.json"
+    assert main(["identify", str(problem_file("demo-frf.uff")), "--out", str(out)]) == 0
+    capsys.readouterr()
+    measured = load_measured(out)
+    assert measured.n_modes == 3 and measured.n_sensors == 9
+    result = diagnose(load_model(problem_file("ss-steel-beam.toml")), measured,
+                      candidates=("material", "crack", "point_mass"))
+    assert result.verdict == "effect_found" and result.best.name == "crack"
+    fit, sigma = result.best.parameters, result.best.uncertainty
+    for key, truth, tolerance in (("position", 0.19, 0.002), ("depth_ratio", 0.5, 0.02)):
+        assert abs(fit[key] - truth) < min(3 * sigma[key], tolerance), (key, fit, sigma)

@@ -46,3 +46,34 @@ def test_bench_eigen_accuracy(tmp_path):
     raw = [r["raw_shift_invert_max_rel_error"] for r in out["rows"] if r["elements"] == 10000]
     assert all(isinstance(e, str) or e > 1e-4 for e in raw)  # raw shift-invert fails there
     assert "the finest mesh whose modal solve gfe-opt verifies" in out["above_ceiling"]
+
+
+def test_shipped_examples_are_what_the_script_writes(tmp_path):
+    """problems/demo-measured.* and demo-frf.uff cannot drift from the code that makes them."""
+    assert "as scripts/make_examples.py writes them" in _run("make_examples.py", "--check",
+                                                            cwd=tmp_path)
+
+
+def test_readme_commands_name_files_that_exist():
+    """What scripts/check_readme.py (run by .ci/run) will run: every block it skips says
+    why, and every repository file a runnable command names exists."""
+    import re
+
+    sys.path.insert(0, str(SCRIPTS))
+    from check_readme import blocks, commands
+
+    root = SCRIPTS.parent
+    found = blocks((root / "README.md").read_text(encoding="utf-8"))
+    runnable = [b for b in found if b[2] is None]
+    assert len(runnable) >= 5 and all(len(b[2]) > 10 for b in found if b[2] is not None)
+    named = []
+    for lang, code, _, line in runnable:
+        text = "\n".join(commands(code)) if lang == "bash" else code
+        named += [(line, f) for f in re.findall(r"\b((?:problems|scripts)/[\w./-]+\.\w+)",
+                                                  text)]
+    assert named
+    missing = [(line, f) for line, f in named if not (root / f).is_file()]
+    assert not missing, missing
+    # the placeholders of old (MODEL.toml, MEASURED.json) are no command anyone can paste
+    assert not [b for b in runnable if b[0] == "bash"
+                and re.search(r"\b(MODEL|MEASURED|FRF)\.\w+", b[1])]
