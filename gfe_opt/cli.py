@@ -212,7 +212,7 @@ def _write_outputs(args, figs, fill_report, title) -> None:
     if args.report:
         report = Report(title)
         fill_report(report)
-        report.figures(figs)
+        report.add_figures(figs)
         report.heading("Reproduce")
         report.preformatted(" ".join(["gfe-opt", *args.argv]))
         report.save(args.report)

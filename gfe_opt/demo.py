@@ -155,10 +155,10 @@ def _write_report(out, report_path, figures, result, diagnosis, outcome, best, m
                      "added and fitted, and the error falls to the measurement noise.")
     report.heading("1. Compare")
     report.preformatted(format_comparison(result, model.length))
-    report.figures(compared)
+    report.add_figures(compared)
     report.heading("2. Diagnose")
     report.preformatted(format_diagnosis(diagnosis, model))
-    report.figures(diagnosed)
+    report.add_figures(diagnosed)
     report.heading("3. Add the effect")
     report.table(["", "frequency error [% rms]", "mean MAC"],
                  [["before", f"{outcome.before.freq_error_rms_pct:.3f}",
@@ -168,7 +168,7 @@ def _write_report(out, report_path, figures, result, diagnosis, outcome, best, m
     report.table(["effect", "fitted parameters", "hidden truth"],
                  [[e.name, format_parameters(e.parameters), format_parameters(DEMO_CRACK)]
                   for e in outcome.model.effects])
-    report.figures(updated)
+    report.add_figures(updated)
     report.heading("Reproduce")
     report.preformatted(f"gfe-opt compare {model_path} {measured_path} --report compare.html\n"
                         f"gfe-opt diagnose {model_path} {measured_path}\n"

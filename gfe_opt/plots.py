@@ -261,7 +261,8 @@ def nodal_coefficients(realisations, bending_rigidity=None, length=None):
     top, middle, bottom = fig.subplots(3, 1, sharex=True)
     x = [r.x for r in realisations]
     top.plot(x, [r.k_ratio for r in realisations], "o-", ms=3,
-             label="$k/k_0$: coefficient of $w''''$")
+             label="$k/k_0$: coefficient of $w''''$ (raw; read against the noise in "
+                   "stiffness_change.png)")
     top.plot(x, [r.mass_ratio for r in realisations], "s-", ms=3,
              label=r"$m/m_0$: coefficient of $\ddot w$")
     top.axhline(1.0, color="0.5", lw=0.8)

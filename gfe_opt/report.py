@@ -129,7 +129,7 @@ class Report:
                        + "</tr>" for row in rows)
         self.parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
 
-    def figures(self, figs: dict) -> None:
+    def add_figures(self, figs: dict) -> None:
         """Every figure of ``figs`` (file name -> figure), captioned with its question."""
         for name, fig in figs.items():
             self.figure(fig, caption(name))

@@ -96,6 +96,7 @@ def test_noise_ten_times_the_stated_level_is_said_not_explained():
     assert abs(last.noise.correlation) < 0.3  # white: noise, not a structure
 
 
+@pytest.mark.slow  # a 60-realisation study (70 s): python -m pytest -m slow (.ci/run runs it)
 @pytest.mark.parametrize("truth,effect,keys", [
     ({"point_masses": [(0.4, 0.2)]}, "point_mass", ("position", "mass")),
     ({"rigidity": christides_barr(0.3, 0.4)}, "crack", ("position", "depth_ratio")),

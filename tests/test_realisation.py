@@ -117,3 +117,21 @@ def test_summaries_name_the_physics():
         lines = summarise(realise(discretise(model.with_effects([Effect(name, params)])), d0))
         assert len(lines) == 1 and words in lines[0], (name, lines)
     assert summarise(realise(d0, d0)) == []
+
+
+def test_profile_words_never_call_ringing_a_finding():
+    """A feature the found effect does not reproduce is 'not a finding' only when that effect
+    fits the whole test to the noise; otherwise it stays an open difference."""
+    from gfe_opt.realisation import Feature, ProfileBand, describe_profile
+
+    x = np.linspace(0.0, 0.5, 11)
+    loss = Feature("loss", 0.2, 0.15, 0.25, 0.4, 0.02)
+    rise = Feature("rise", 0.4, 0.4, 0.4, 1.2, 0.03)
+    band = ProfileBand(x, np.ones_like(x), np.full_like(x, 0.02), np.ones_like(x),
+                       (loss, rise), np.ones_like(x), explained=np.ones_like(x),
+                       unexplained=(rise,))
+    fits, open_ = (describe_profile(band, "crack", explains_test=flag) for flag in (True, False))
+    assert "own modes show it too" in fits[0] and "own modes show it too" in open_[0]
+    assert "not a finding" in fits[1] and "not a finding" not in open_[1]
+    assert "not reproduced by the fitted crack" in open_[1]
+    assert "(at one node)" in fits[1] and "0.150 to 0.250 m" in fits[0]
