@@ -9,6 +9,7 @@ thousand within a minute) or ``long`` (``python scripts/fuzz.py``, or
 """
 
 import contextlib
+import copy
 import io
 import json
 import os
@@ -140,7 +141,9 @@ def structure_mutation(draw, tree):
         key = path[-1]
         op = draw(st.sampled_from(["value", "delete", "rename", "grow", "shrink"]))
         if op == "value":
-            parent[key] = draw(st.sampled_from(WEIRD))
+            # a copy: a later delete inside [1, 2] must not change WEIRD itself (hypothesis
+            # saw the next examples draw differently: FlakyStrategyDefinition)
+            parent[key] = copy.deepcopy(draw(st.sampled_from(WEIRD)))
         elif op == "delete":
             del parent[key]
         elif op == "rename" and isinstance(parent, dict):
