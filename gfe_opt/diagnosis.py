@@ -563,6 +563,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                                ref_misfit,
                                sel.floor)
     verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate)
+    words = (words or []) + _band_caution(words, estimate)
     if verdict == "effect_found" and not suggested:
         suggested = [ranked[0].name]
     alike = _alike(ranked, sel) if verdict == "effect_found" else []
@@ -788,6 +789,18 @@ def _noise_notes(est: NoiseEstimate, verdict: str) -> list[str]:
             notes.append("the model agrees with the test at the noise the data imply; give "
                          "--freq-noise/--shape-noise if the test's noise is known")
     return notes
+
+
+def _band_caution(words, est: NoiseEstimate) -> list[str]:
+    """The generic update's features are read against a band made at the stated or assumed
+    shape noise; when the data imply much more, the band is too narrow: say so."""
+    if (not words or words[0].startswith("no change") or est.implied_shape is None
+            or est.implied_shape <= 1.5 * est.shape):
+        return []
+    return [f"caution: read against a noise band for {100 * est.shape:.2g} % shape noise "
+            f"({'stated' if est.given else 'assumed'}); the data imply "
+            f"{100 * est.implied_shape:.2g} %, so the band is too narrow and not every "
+            "feature above is a finding"]
 
 
 def _words_for_verdict(words: list[str], verdict: str) -> list[str]:

@@ -54,6 +54,8 @@ def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pin
     features beyond it labelled, and, when an effect was found, what the update reads
     from that effect's own modes; below, the structure with the located place and the
     fitted effects (``findings`` as for :func:`structure_sketch`)."""
+    from .realisation import COLLAPSED
+
     fig = _figure(7.0, 4.6 if length is not None else 3.6)
     if length is not None:
         ax, sketch = fig.subplots(2, 1, sharex=True, height_ratios=(3.4, 1.1))
@@ -71,7 +73,8 @@ def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pin
         if f.kind not in ("loss", "rise"):
             continue
         grey = f in band.unexplained and band.explained is not None
-        ax.annotate(f"{f.value:.2f}±{f.sigma:.2f}", (f.x, f.value), textcoords="offset points",
+        text = "collapsed" if f.value <= COLLAPSED else f"{f.value:.2f}±{f.sigma:.2g}"
+        ax.annotate(text, (f.x, f.value), textcoords="offset points",
                     xytext=(0, -12 if f.kind == "loss" else 6), ha="center", fontsize=7,
                     color="0.45" if grey else "black")
     ax.axhline(1.0, color="0.4", lw=0.8)
@@ -152,7 +155,7 @@ def paired_frequencies(pairs):
     right.set_xticks(modes)
     right.set_xlabel("test mode")
     right.set_ylabel(r"$(f_\mathrm{model} - f_\mathrm{test}) / f_\mathrm{test}$ [%]")
-    right.set_title("Model error (red: model too stiff)", fontsize=10)
+    right.set_title("Model error (red: model higher, blue: lower)", fontsize=10)
     right.margins(y=0.15)
     return fig
 

@@ -260,6 +260,8 @@ BAND_SAMPLES = 6
 FEATURE_SIGMAS = 3.0
 #: ... and, for a local one, this relative change (the update's own systematic scatter)
 FEATURE_CHANGE = 0.05
+#: a nodal stiffness ratio at or below this is the update collapsing, not a reading
+COLLAPSED = 0.05
 
 
 @dataclass(frozen=True)
@@ -287,8 +289,12 @@ class Feature:
         word = "loss" if self.kind == "loss" else "rise"
         extent = ("at one node" if self.x_from == self.x_to else
                   f"{self.x_from:.3f} to {self.x_to:.3f} m")
+        if self.value <= COLLAPSED:
+            return (f"the update collapses near x = {self.x:.3f} m ({extent}): k = "
+                    f"{self.value:.2f} of the model's, no physical reading (the nodal family "
+                    "cannot fit the data there)")
         return (f"a local stiffness {word} near x = {self.x:.3f} m ({extent}): "
-                f"k = {self.value:.2f} ± {self.sigma:.2f} of the model's")
+                f"k = {self.value:.2f} ± {self.sigma:.2g} of the model's")
 
 
 @dataclass(frozen=True)

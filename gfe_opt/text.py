@@ -105,10 +105,11 @@ def format_diagnosis(result, model) -> str:
                      f"{_ratio(best.misfit.chi2_per_residual)}")
         pair = result.together
         if pair is not None:
-            added = pair.effects[len(model.effects):]
-            lines.append("  with " + "; ".join(
-                f"{e.name}: {effect_type(e.name).describe(e.parameters, s)}"
-                for e, s in zip(added[1:], pair.sigma[len(model.effects) + 1:])))
+            held = len(model.effects)
+            lines.append("  together, fitted with each other (what update --add gives; the "
+                         "figures show these):")
+            lines += [f"    {e.name}: {effect_type(e.name).describe(e.parameters, s)}"
+                      for e, s in zip(pair.effects[held:], pair.sigma[held:])]
             lines.append(f"  together: frequency error {now.freq_error_rms_pct:.3f} % -> "
                          f"{pair.misfit.freq_error_rms_pct:.3f} %, χ²/n "
                          f"{_ratio(now.chi2_per_residual)} -> "
