@@ -209,11 +209,18 @@ def localisation(x, residual, comac, length, supports=("pinned", "pinned"), plac
     return fig
 
 
-def candidate_errors(fits, baseline_pct, together=None, verdict=None):
+def candidate_errors(fits, baseline_pct, together=None, verdict=None, *, length=None,
+                     supports=("pinned", "pinned"), findings=()):
     """Frequency error left by each candidate effect (significant ones coloured) and, when
-    a pair is suggested, by the pair (hatched, on top)."""
-    fig = _figure(7.0, 3.2)
-    ax = fig.add_subplot()
+    a pair is suggested, by the pair (hatched, on top); with ``findings`` (as for
+    :func:`structure_sketch`) and the ``length``, the structure with them below."""
+    sketch = None
+    if findings and length is not None:
+        fig = _figure(7.0, 4.4)
+        ax, sketch = fig.subplots(2, 1, height_ratios=(3.2, 1.0))
+    else:
+        fig = _figure(7.0, 3.2)
+        ax = fig.add_subplot()
     names = [f.effect for f in fits]
     values = [f.misfit.freq_error_rms_pct for f in fits]
     # the effect found (the first significant one) green, others also significant pale
@@ -238,6 +245,9 @@ def candidate_errors(fits, baseline_pct, together=None, verdict=None):
     if verdict:
         fig.suptitle(f"verdict: {verdict}", fontsize=10, fontweight="bold")
     ax.legend(fontsize=8)
+    if sketch is not None:
+        structure_sketch(sketch, length, supports, findings=findings)
+        sketch.set_xlabel("x [m]: the effects found")
     return fig
 
 

@@ -50,16 +50,17 @@ def diagnosis_figures(diagnosis, model) -> dict:
     band and what the effect found would show, the structure with the located place and
     the fitted effects, the nodal equation coefficients and (for a crack) the identified
     Q_i against Christides–Barr Q(x)."""
+    found = findings(diagnosis, model)
     figs = {"candidates.png": plots.candidate_errors(
         diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
-        verdict=verdict_title(diagnosis))} if diagnosis.fits else {}
+        verdict=verdict_title(diagnosis), length=model.length, supports=model.supports,
+        findings=found)} if diagnosis.fits else {}
     band = diagnosis.profile_band
     best = diagnosis.best
     if band is not None:
         figs["stiffness_change.png"] = plots.profile_with_band(
             band, label=best.name if best else None, length=model.length,
-            supports=model.supports, places=diagnosis.localisation or (),
-            findings=findings(diagnosis, model))
+            supports=model.supports, places=diagnosis.localisation or (), findings=found)
         if best is not None:
             figs.update(effect_type(best.name).figures(model, best.parameters, band))
     if diagnosis.nodal:

@@ -350,10 +350,11 @@ class EffectType:
 
     def mark(self, ax, model, params: dict, sigma: dict | None, y: float) -> None:
         """Draw the effect on the structure sketch (a matplotlib axis, x in m) at height y;
-        default: the name and the fitted values at mid-span for global effects."""
-        ax.annotate(f"{self.name}: {self.describe(params, sigma)}", (model.length / 2, y),
-                    textcoords="offset points",
-                    xytext=(0, 8), ha="center", fontsize=7, color="tab:red")
+        default, for effects of the whole structure: the name and the fitted values, from
+        the left end."""
+        ax.annotate(f"{self.name}: {self.describe(params, sigma)}", (0.0, y),
+                    textcoords="offset points", xytext=(0, 8), ha="left", fontsize=7,
+                    color="tab:red")
 
     def position(self, params: dict) -> float | None:
         """Where a local effect sits [m] (None for distributed ones)."""
