@@ -58,7 +58,8 @@ class SectionLoss(EffectType):
 
     def mark(self, ax, model, params, sigma, y):
         c, ell = params["position"], params["length"]
-        ax.axvspan(c - ell / 2, c + ell / 2, color="tab:orange", alpha=0.35, lw=0)
+        ax.plot([c - ell / 2, c + ell / 2], [0.0, 0.0], lw=9, color="tab:orange",
+                solid_capstyle="butt", zorder=4)  # the zone on the beam
         ax.annotate(f"EI×{params['stiffness_ratio']:.2f}, ρA×{params['mass_ratio']:.2f}",
                     (c, y), textcoords="offset points", xytext=(0, 9), ha="center",
                     fontsize=7, color="tab:orange")
