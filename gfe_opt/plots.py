@@ -342,7 +342,7 @@ def stabilisation(identification):
     ax.set_ylabel("model order")
     ax.set_zorder(ax2.get_zorder() + 1)
     ax.patch.set_visible(False)
-    ax.legend(fontsize=8, loc="upper left")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(0.06, 1.0))  # off mode 1
     ax.set_title("Stabilisation chart (LSCF)")
     return fig
 
@@ -378,7 +378,7 @@ def trend_parameters(trend):
             if onset.effect == effect:
                 ax.axvline(x[onset.index], color="tab:red", ls="--", lw=1,
                            label=f"significant from {onset.when}")
-        ax.set_ylabel(key.replace("_", " "), fontsize=8)
+        ax.set_ylabel(_parameter_label(key), fontsize=8)
         ax.grid(alpha=0.3)
         handles, _ = ax.get_legend_handles_labels()
         if handles:
@@ -386,6 +386,18 @@ def trend_parameters(trend):
     axes[0].set_title(f"Fitted parameters over {len(x)} sets")
     _trend_axis(axes[-1], trend)
     return fig
+
+
+def _parameter_label(key: str) -> str:
+    """``crack.position`` -> ``crack\nposition [m]`` (the unit from the effect's
+    parameter; ``crack#2.position`` for a repeated effect)."""
+    from .effects import EFFECTS
+
+    effect, _, name = key.partition(".")
+    kind = EFFECTS.get(effect.split("#")[0])
+    unit = next((p.unit for p in (kind.parameters if kind else ()) if p.name == name), None)
+    suffix = f" [{unit}]" if unit and unit != "-" else ""
+    return f"{effect}\n{name.replace('_', ' ')}{suffix}"
 
 
 def trend_errors(trend):
