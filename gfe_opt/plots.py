@@ -108,11 +108,14 @@ def disturbance_function(x_nodes, q_identified, x_fine, q_exact, *, label_exact:
 
 def mac_matrix(mac, pairs=()):
     """MAC heat map, test modes down and model modes across, with the values in the cells.
-    Only the model modes up to the highest paired one are drawn (the rest are computed to
-    pair against, and would fill the figure with zeros)."""
+    Only the model modes up to the highest paired one (or best match of a test mode) are
+    drawn: the rest are computed to pair against, and would fill the figure with zeros."""
     mac = np.asarray(mac)
     pairs = set(pairs)
-    shown = max([j for _, j in pairs], default=mac.shape[1] - 1) + 1
+    # up to the highest paired model mode, and each test mode's best match (an unpaired
+    # test mode's best model mode must stay visible)
+    best = [int(np.argmax(row)) for row in mac] if mac.size else []
+    shown = max([j for _, j in pairs] + best, default=mac.shape[1] - 1) + 1
     shown = min(max(shown, mac.shape[0]), mac.shape[1])
     cropped = mac[:, :shown]
     fig = _figure(1.6 + 0.6 * shown, 1.0 + 0.5 * mac.shape[0])

@@ -45,7 +45,8 @@ def test_compare_figures_show_the_data(case):
     figs = compare_figures(result, model)
     mac_ax = figs["mac.png"].axes[0]
     # the paired model modes only: as many columns as the highest paired model mode
-    shown = max(p.model_mode for p in result.pairs)
+    shown = max(max(p.model_mode for p in result.pairs),
+                int(np.max(np.argmax(result.mac_matrix, axis=1))) + 1)
     assert shown < result.mac_matrix.shape[1]
     assert mac_ax.images[0].get_array().shape == (measured.n_modes, shown)
     bold = {(round(t.get_position()[1]), round(t.get_position()[0])) for t in mac_ax.texts
