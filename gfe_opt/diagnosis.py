@@ -806,8 +806,10 @@ def _band_caution(words, est: NoiseEstimate) -> list[str]:
 def _words_for_verdict(words: list[str], verdict: str) -> list[str]:
     """The generic update's words never contradict the verdict."""
     if verdict == "consistent" and words and not words[0].startswith("no change"):
-        return ["the generic-element update shows " + "; ".join(words)
-                + " — none of it significant in the fits of physical effects"]
+        shown = [w for w in words if not w.startswith("caution:")]
+        return ["the generic-element update shows " + "; ".join(shown)
+                + " — none of it significant in the fits of physical effects",
+                *[w for w in words if w.startswith("caution:")]]
     return words
 
 

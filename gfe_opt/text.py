@@ -123,8 +123,8 @@ def format_diagnosis(result, model) -> str:
                  if result.localisation else "where it fails is unknown without mode shapes")
         lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 fits to the noise); {where}")
     words = list(result.realisation)
-    if len(words) == 1 and words[0].startswith("the generic-element update"):
-        lines.append(words[0])
+    if words and words[0].startswith("the generic-element update"):
+        lines += words[:1] + [f"  {w}" for w in words[1:]]
     elif words:
         lines.append("the generic-element update (nodal k_i, no physical effect assumed):")
         lines += [f"  - {word}" for word in words]
