@@ -193,7 +193,8 @@ def test_two_cracks_with_more_noise_than_assumed_text_and_figures_agree():
     sensors = interior_sensors(model.length, 30)
     beam = ReferenceBeam(rigidity=product(christides_barr(0.12, 0.4), christides_barr(0.42, 0.4)))
     f, y = beam.measure(5, sensors, seed=11, shape_noise=0.006, freq_noise=0.001)
-    result = diagnose(model, make_measured(sensors, "w", f, y, "two cracks"), realise=True)
+    result = diagnose(model, make_measured(sensors, "w", f, y, "two cracks"), realise=True,
+                      candidates=("material", "crack", "section_loss", "point_mass"))
     pair = result.together
     assert result.verdict == "effect_found" and pair is not None
     positions = sorted(e.parameters["position"] for e in pair.effects)
