@@ -38,11 +38,12 @@ def findings(diagnosis, model) -> list:
 
 
 def verdict_title(diagnosis) -> str:
-    """``crack missing``, ``consistent with the test`` or ``nothing known explains it``."""
+    """``crack missing``, else the verdict in the words the text prints."""
+    from .text import VERDICT_WORDS
+
     if diagnosis.verdict == "effect_found":
         return " + ".join(diagnosis.suggested) + " missing"
-    return {"consistent": "consistent with the test within the noise",
-            "unexplained": "no known effect explains the difference"}[diagnosis.verdict]
+    return VERDICT_WORDS[diagnosis.verdict]
 
 
 def diagnosis_figures(diagnosis, model) -> dict:
