@@ -73,7 +73,10 @@ from .fitting import (
     fit_effects,
     jsonable,
     misfit,
+    TIE,
+    lowest,
     noise_of,
+    ranked,
     slots_for,
 )
 from .measured import MeasuredModes, on_model, sensor_matrix
@@ -280,11 +283,19 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
         fit = fit_effects(model, measured, [*extra, Effect(name, starts[0])], noise=noise,
                           name=name, alternatives=starts[1:],
                           multistart=True if extra and measured.frequency_only else "auto")
-        if best is None or fit.misfit.chi2 < best.misfit.chi2:
+        if best is None or _preferred(fit, best):
             best = fit
     if extra:
         best.added = len(model.effects) + len(extra)
     return best
+
+
+def _preferred(fit, other) -> bool:
+    """``fit`` is the better of two fits of one candidate: converged before not, then a
+    lower χ² beyond rounding (a tie keeps the earlier)."""
+    if fit.success != other.success:
+        return fit.success
+    return fit.misfit.chi2 < other.misfit.chi2 - TIE * max(other.misfit.chi2, 1.0)
 
 
 def _fit_profile(model, measured, name, noise, x, start_ratio):
@@ -543,8 +554,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                          f"{partial.misfit.chi2_per_residual:.3g}: {partial.describe()}), but "
                          "neither it, nor it with one more effect, nor a free profile brings "
                          "the misfit to the noise")
-    ranked = [f for f in fits if not f.failed]
-    ranked.sort(key=lambda f: (not f.significant, sel.penalised(f)))
+    ranked = _rank([f for f in fits if not f.failed and f.significant], sel) + _rank(
+        [f for f in fits if not f.failed and not f.significant], sel)
     failed = [f for f in fits if f.failed]
     if realise and generic is not None:
         from .realisation import describe_profile, explain
@@ -609,7 +620,12 @@ def _discretise(model):
 
 def _best(fits, sel):
     significant = [f for f in fits if f.significant and not f.failed]
-    return min(significant, key=sel.penalised) if significant else None
+    return _rank(significant, sel)[0] if significant else None
+
+
+def _rank(fits, sel) -> list:
+    """Fits by the information criterion, ties within rounding kept in candidate order."""
+    return [fits[i] for i in ranked([sel.penalised(f) for f in fits])]
 
 
 def _fallback(model, measured, noise, names, sel, band, progress):
@@ -643,8 +659,9 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
     """``best`` with one more effect: every other candidate that fitted, and a further
     instance of ``best`` when it is local.  Returns the simplest pair that ``explains`` the data (χ²
     plus the pair's parameter count as a tie-break), else None."""
-    others = [f for f in sorted(fits, key=lambda f: f.misfit.chi2)
-              if f is not best and not f.failed and f.name != best.name
+    # a candidate whose own fit did not converge is still tried as the second effect
+    others = [f for f in (fits[i] for i in ranked([f.misfit.chi2 for f in fits]))
+              if f is not best and (not f.failed or not f.success) and f.name != best.name
               and not getattr(effect_type(f.name), "fallback", False)]
     seconds = ([best.name] if effect_type(best.name).local else []) + [f.name for f in others]
     first = Effect(best.name, best.parameters)
@@ -653,7 +670,7 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
                            [alone[name]] if name in alone else []))
             for name in seconds]
     pairs = [p for p in _run_jobs(jobs, None, seconds) if p.success and explains(p)]
-    return min(pairs, key=sel.penalised, default=None)
+    return _rank(pairs, sel)[0] if pairs else None
 
 
 def _generic_update(model, measured, noise):
@@ -737,8 +754,8 @@ def _noise_estimate(model, measured, noise, fits, C, ref_misfit, floor) -> Noise
     """The noise the data imply: the most flexible fit's frequency and shape residuals
     against their degrees of freedom."""
     usable = [f for f in fits if f is not None and not f.failed]
-    flexible = min(usable, key=lambda f: f.misfit.chi2 / max(f.misfit.n_residuals - f.n_params,
-                                                             1), default=None)
+    flexible = usable[lowest([f.misfit.chi2 / max(f.misfit.n_residuals - f.n_params, 1)
+                              for f in usable])] if usable else None
     m = flexible.misfit if flexible else ref_misfit
     p = flexible.n_params if flexible else 0
     if measured.frequency_only:
