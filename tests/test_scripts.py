@@ -50,8 +50,33 @@ def test_bench_eigen_accuracy(tmp_path):
 
 def test_shipped_examples_are_what_the_script_writes(tmp_path):
     """problems/demo-measured.* and demo-frf.uff cannot drift from the code that makes them."""
-    assert "as scripts/make_examples.py writes them" in _run("make_examples.py", "--check",
-                                                            cwd=tmp_path)
+    assert "hold what scripts/make_examples.py writes" in _run("make_examples.py", "--check",
+                                                              cwd=tmp_path)
+
+
+def test_example_check_compares_values_and_names_what_differs(tmp_path):
+    """--check compares by value: a change of the last printed digit is no drift, a change of
+    a value beyond the tolerance is named with its size."""
+    sys.path.insert(0, str(SCRIPTS))
+    try:
+        import make_examples
+    finally:
+        sys.path.remove(str(SCRIPTS))
+    from gfe_opt.measured import load_measured, save_measured
+
+    shipped = SCRIPTS.parent / "problems" / "demo-measured.json"
+    m = load_measured(shipped)
+    scale = float(abs(m.shapes).max())
+    for factor, named in ((1e-9, False), (1e-4, True)):
+        shapes = m.shapes.copy()
+        shapes[3, 1] += factor * scale
+        changed = tmp_path / f"{factor:g}" / "demo-measured.json"
+        changed.parent.mkdir()
+        save_measured(type(m)(m.x, m.dof, m.frequencies_hz, shapes, m.source), changed)
+        lines = make_examples.differences(shipped, changed)
+        assert bool(lines) == named, lines
+        if named:
+            assert "shapes[3, 1]" in lines[0] and "differs by 0.0001 of the largest" in lines[0]
 
 
 def test_readme_commands_name_files_that_exist():
