@@ -67,6 +67,7 @@ from .fitting import (
     ALIKE_CHI2,
     DEFAULT_FREQ_NOISE,
     DEFAULT_SHAPE_NOISE,
+    SOLVER_TALLY,
     TIE,
     Fit,
     Misfit,
@@ -306,9 +307,15 @@ def _fit_profile(model, measured, name, noise, x, start_ratio):
 
 
 def _job(args):
+    """One fit; returns it with the solver tally it added (counted in the parent when the
+    job ran in a worker process)."""
+    from .fitting import SOLVER_TALLY
+
     kind, payload = args
-    return {"profile": _fit_profile, "candidate": _fit_candidate,
-            "generic": _generic_update}[kind](*payload)
+    before = SOLVER_TALLY.copy()
+    result = {"profile": _fit_profile, "candidate": _fit_candidate,
+              "generic": _generic_update}[kind](*payload)
+    return result, SOLVER_TALLY - before
 
 
 def _run_jobs(jobs, progress, labels):
@@ -327,7 +334,8 @@ def _run_jobs(jobs, progress, labels):
         try:
             futures = {pool.submit(_job, job): i for i, job in enumerate(jobs)}
             for done, future in enumerate(as_completed(futures), start=1):
-                results[futures[future]] = future.result()
+                results[futures[future]], tally = future.result()
+                SOLVER_TALLY.update(tally)
                 if progress:
                     progress(done, len(jobs), labels[futures[future]])
         except BaseException:
@@ -341,7 +349,7 @@ def _run_jobs(jobs, progress, labels):
         with threadpool_limits(limits=1):
             for i, job in enumerate(jobs):
                 if results[i] is None:
-                    results[i] = _job(job)
+                    results[i] = _job(job)[0]
                 if progress:
                     progress(i + 1, len(jobs), labels[i])
     return results

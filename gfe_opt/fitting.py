@@ -563,8 +563,9 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
 
     Steps are damped Newton steps on χ² with the Hessian JᵀJ + S: J the second-order
     difference Jacobian (:func:`_jacobian2`), S the second-order term Σ rᵢ∇²rᵢ built up by
-    the structured secant update of Dennis, Gay & Welsch (NL2SOL; it matters when the residuals are large: a fit that does
-    not reach the noise zig-zagged for 60 Gauss–Newton steps).  The fit has converged when
+    the structured secant update of Dennis, Gay & Welsch (NL2SOL; it matters when the
+    residuals are large: a fit that does not reach the noise zig-zagged for 60 Gauss–Newton
+    steps).  The fit has converged when
     the Newton decrement gᵀH⁻¹g (g = Jᵀr, the decrease of χ² a full step predicts; also the
     Gauss–Newton one) falls below :data:`FINISH_DECREMENT` times the noise floor
     max(1, χ²/(n − p)): the distance to the optimum is then √FINISH_DECREMENT standard

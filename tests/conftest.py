@@ -1,6 +1,8 @@
 """Shared builders for test models (plain dicts in the model-file form)."""
 
 import copy
+import sys
+from collections import Counter
 
 import pytest
 from hypothesis import settings
@@ -41,3 +43,26 @@ def make_model(base=STEEL_BEAM, **changes):
 @pytest.fixture
 def beam():
     return make_model()
+
+
+@pytest.fixture(autouse=True)
+def _fits_converge(request):
+    """No fit of the suite stops at IPOPT's "acceptable" level (issue 20: those stops sat on
+    finite-difference noise and moved with the BLAS kernel); a test about such a stop is
+    marked ``acceptable_stop``.  Fits in worker processes are counted too (their tallies
+    come back with their results)."""
+    fitting = sys.modules.get("gfe_opt.fitting")
+    before = fitting.SOLVER_TALLY.copy() if fitting else None
+    yield
+    fitting = sys.modules.get("gfe_opt.fitting")
+    if fitting is None or "acceptable_stop" in request.keywords:
+        return
+    grown = fitting.SOLVER_TALLY - (before or Counter())
+    assert grown["Solved_To_Acceptable_Level"] == 0, dict(grown)
+
+
+def pytest_terminal_summary(terminalreporter):
+    fitting = sys.modules.get("gfe_opt.fitting")
+    if fitting is not None and fitting.SOLVER_TALLY:
+        tally = dict(sorted(fitting.SOLVER_TALLY.items()))
+        terminalreporter.write_line(f"effect fits of this run (IPOPT status, finish): {tally}")
