@@ -53,7 +53,9 @@ class SectionLoss(EffectType):
                 # stiffer zone, and which side a valley of frequencies alone ends on then
                 # hinged on rounding
                 Variable("stiffness_ratio", 0.05, 3.0, (0.7, 1 / 0.7)),
-                Variable("mass_ratio", 0.05, 3.0, (1.0,))]
+                # lighter and heavier alike: corrosion (EI and ρA × 0.7) is no better than
+                # nothing with ρA held at 1, so a start at 1 alone never found it
+                Variable("mass_ratio", 0.05, 3.0, (0.7, 1.0, 1 / 0.7))]
 
     def starts(self, model, hint):
         return [{}, *({"position": hint * model.length, "length": 0.05 * model.length,
