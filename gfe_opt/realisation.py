@@ -324,12 +324,23 @@ def _generic_ratio_of(disc, data, noise, n):
     return result.q[:n + 1] / result.q0[:n + 1] if result.ok else None
 
 
-def own_modes(disc: Discretisation, measured):
-    """The modes of ``disc`` at the measured sensors, noise-free, as measured data."""
-    from .measured import make_measured, sensor_matrix
-    from .modal import discretisation_modes
+def vibrating_modes(disc: Discretisation, n_modes: int):
+    """The lowest ``n_modes`` modes of ``disc`` after its rigid-body modes (a free or
+    pinned-free model has them; a test never measures them)."""
+    from .modal import Modes, discretisation_modes, rigid_body_count
 
-    modes = discretisation_modes(disc, measured.n_modes)
+    rigid = rigid_body_count(disc)
+    modes = discretisation_modes(disc, n_modes + rigid)
+    return Modes(frequencies_hz=modes.frequencies_hz[rigid:rigid + n_modes],
+                 shapes=modes.shapes[:, rigid:rigid + n_modes])
+
+
+def own_modes(disc: Discretisation, measured):
+    """The vibrating modes of ``disc`` at the measured sensors, noise-free, as measured data
+    (as many as were measured; a 0 Hz "measured" mode would be refused as bad input)."""
+    from .measured import make_measured, sensor_matrix
+
+    modes = vibrating_modes(disc, measured.n_modes)
     C = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
     return make_measured(measured.x, measured.dof, modes.frequencies_hz, C @ modes.shapes,
                          measured.source)
@@ -416,11 +427,9 @@ def _determined(disc: Discretisation, measured) -> np.ndarray:
     """Nodes whose bending stiffness the measured modes determine: the mean over modes of
     (curvature at the node / the mode's largest curvature)² at least 1 %.  At a pinned or
     free end the moment, and with it what the data say about k, vanishes."""
-    from .modal import discretisation_modes
-
     if disc.kind != "beam":
         return np.ones(len(disc.nodes), dtype=bool)
-    modes = discretisation_modes(disc, measured.n_modes)
+    modes = vibrating_modes(disc, measured.n_modes)
     L = disc.element_length
     u = modes.shapes[disc.element_dofs()] * el.beam_dof_scaling(L)[None, :, None]
     left = np.einsum("i,eim->em", el.hermite_d2(0.0), u)
