@@ -94,6 +94,9 @@ WHITE_NOISE_CORRELATION = 0.3
 #: frequencies off by more than this many times the assumed noise are not noise
 FREQ_NOISE_LIMIT = 4.0
 VERDICTS = ("consistent", "effect_found", "unexplained")
+#: a candidate must lower χ² by at least this much to be ranked at all (every significance
+#: threshold is far larger: χ²₁(1 − 10⁻³) = 10.8)
+NO_GAIN = 0.5
 
 
 def quantile(p: int, alpha: float) -> float:
@@ -493,12 +496,14 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     fits = _run_jobs(jobs, progress, labels) if jobs else []
     generic, band = fits.pop() if with_generic else (None, None)
     for f in fits:
-        # worse than the model without it (beyond rounding): a failed fit, not a candidate
-        f.failed = (not f.success) or f.misfit.chi2 > ref_misfit.chi2 * (1 + 1e-4) + 0.5
+        # no better than the model without it (by less than half a unit of χ²: an effect
+        # at its null, whose other parameters then do not matter and may not converge): a
+        # failed fit, not a candidate, whether or not its solve converged
+        no_gain = f.misfit.chi2 > ref_misfit.chi2 - NO_GAIN
+        f.failed = no_gain or not f.success
         if f.failed:
-            f.notes.append(f"solver: {f.status}" if not f.success else
-                           f"at best χ²/n {f.misfit.chi2_per_residual:.4g}, worse than "
-                           "without it")
+            f.notes.append(f"at best χ²/n {f.misfit.chi2_per_residual:.4g}, no better than "
+                           "without it" if no_gain else f"solver: {f.status}")
     sel = _Selection(ref_misfit.chi2, ref_params, len(fits) + len(fallback_names),
                      measured.n_modes)
     sel.floor = _floor([*fits, reference])

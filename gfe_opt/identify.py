@@ -354,7 +354,9 @@ def _pole_index(poles, f, zeta):
 def _real_shapes(constants) -> np.ndarray:
     """Complex modal constants (n_points, n_modes) as real shapes: each column rotated by
     the phase of its largest entry and its real part kept."""
+    from .modal import peak_rows
+
     A = np.atleast_2d(constants)
-    peak = np.argmax(np.abs(A), axis=0)
+    peak = peak_rows(A)
     phase = np.angle(A[peak, np.arange(A.shape[1])])
     return np.real(A * np.exp(-1j * phase)[None, :])

@@ -79,7 +79,8 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     """Lowest ``n_modes`` eigenpairs of the sparse pencil (K, M) with DOFs ``constrained`` fixed.
 
     Returns :class:`Modes` with shapes expanded to all DOFs (zeros at constrained ones),
-    mass-normalised, sign fixed so that the largest-magnitude entry is positive.  Eigenvalues
+    mass-normalised, sign fixed so that the largest-magnitude entry is positive (the first of
+    equal ones, :func:`peak_rows`).  Eigenvalues
     smaller in magnitude than ``roundoff_fraction`` of the largest one computed are rigid-body
     roundoff (zero); other negative ones are an error.
     """
@@ -129,9 +130,22 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     shapes[free] = d[:, None] * vec
     gen_mass = np.einsum("ij,ij->j", shapes, M @ shapes)
     shapes /= np.sqrt(gen_mass)
-    peak = np.argmax(np.abs(shapes), axis=0)
-    shapes *= np.sign(shapes[peak, np.arange(n_modes)])
+    shapes *= np.sign(shapes[peak_rows(shapes), np.arange(n_modes)])
     return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=shapes)
+
+
+#: entries within this fraction of a mode's largest magnitude count as its peak
+PEAK_TIE = 1e-6
+
+
+def peak_rows(shapes) -> np.ndarray:
+    """Per column, the first row whose magnitude is within :data:`PEAK_TIE` of the column's
+    largest: the entry whose sign (or phase) a mode is given.  Not plain argmax: a mode of a
+    symmetric structure has two peaks of one size, and which of them is larger by the last
+    bit changed with the BLAS kernel, and with it the sign of the mode (and of the noise
+    added to it by the realisation's noisy copies)."""
+    a = np.abs(np.atleast_2d(shapes))
+    return np.argmax(a >= (1.0 - PEAK_TIE) * np.max(a, axis=0), axis=0)
 
 
 def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
@@ -290,8 +304,7 @@ def _reduce_and_solve(disc, K, M, n_modes, groups, params):
     for shapes in (guyan, corrected):
         shapes[disc.constrained] = 0.0
         shapes = shapes / np.sqrt(np.einsum("ij,ij->j", shapes, M @ shapes))
-        peak = np.argmax(np.abs(shapes), axis=0)
-        out.append(shapes * np.sign(shapes[peak, np.arange(shapes.shape[1])]))
+        out.append(shapes * np.sign(shapes[peak_rows(shapes), np.arange(shapes.shape[1])]))
     return out
 
 
