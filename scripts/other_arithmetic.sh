@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The same answers under other arithmetic (issue 20): the tests that carry a decision of
-# the tool (the real-data loop and its README output, the diagnosis and frequency-only
-# tests, the open-world and figure tests, identification, the batch table, the shipped
-# examples) run again under other OpenBLAS kernels and with one BLAS thread; each run must
-# pass.  Sandybridge (AVX) and Haswell (AVX2) run on any x86-64 machine of this kind;
+# the tool (the real-data loop and the demo with their README output, the diagnosis and
+# frequency-only tests, the open-world, free-free and figure tests, identification, the batch
+# table, the shipped examples) run again under other OpenBLAS kernels and with one BLAS
+# thread; each run must pass.  Sandybridge (AVX) and Haswell (AVX2) run on any x86-64 machine of this kind;
 # SkylakeX (AVX-512) only where the processor has it.  `--full` runs the whole suite under
 # each setting instead of the decision tests.
 #
@@ -19,7 +19,9 @@ DECISIONS=(
     tests/test_identify.py
     tests/test_batch.py
     tests/test_effects.py
+    tests/test_free_free.py
     tests/test_scripts.py::test_shipped_examples_are_what_the_script_writes
+    tests/test_cli.py::test_demo_tells_the_whole_story_and_refuses_to_overwrite
 )
 if [[ "${1:-}" == "--full" ]]; then
     DECISIONS=()

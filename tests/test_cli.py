@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -65,6 +66,17 @@ def test_missing_file_exits_2(files, capsys):
     assert "no such file" in capsys.readouterr().err
 
 
+def readme_demo_lines() -> list[str]:
+    """The lines of the README's two demo blocks (step 3, steps 4-6) except "..."."""
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    top = text.split("## Using it")[0]
+    blocks = [b.split("```")[0] for b in top.split("```\n")[1:] if b.startswith("   ")]
+    lines = [line for b in blocks[:2] for line in b.splitlines()
+             if line.strip() and line.strip() != "..."]
+    assert len(lines) > 25, lines
+    return lines
+
+
 def test_demo_tells_the_whole_story_and_refuses_to_overwrite(tmp_path, capsys):
     out = tmp_path / "demo"
     assert main(["demo", "--out", str(out)]) == 0
@@ -73,6 +85,10 @@ def test_demo_tells_the_whole_story_and_refuses_to_overwrite(tmp_path, capsys):
     assert "the model fails most near x = 0.1" in text
     assert "verdict: an effect is missing\n     crack: position = 0.19" in text
     assert "nothing significant is left: consistent" in text
+    # issue 20: the README's demo blocks are what the demo prints, under every BLAS kernel
+    # (.ci/run runs this test under several), every line but the abbreviations
+    for line in readme_demo_lines():
+        assert line in text.splitlines(), line
     updated = load_model(out / "updated.toml")
     assert [e.name for e in updated.effects] == ["crack"]
     assert abs(updated.effects[0].parameters["position"] - 0.19) < 0.015
