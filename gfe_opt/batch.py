@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import GfeInputError
+from .outputs import check_output_path, create_exclusive, open_own
 
 MEASURED_SUFFIXES = (".json", ".csv", ".uff", ".unv")
 TABLE_SUFFIXES = (".parquet", ".csv")
@@ -171,9 +172,14 @@ def read_table(path) -> list[dict]:
         except Exception as exc:  # pyarrow's errors are many kinds
             raise GfeInputError(str(path), None, f"not a readable Parquet table ({exc})"
                                 ) from None
-    with open(path, newline="", encoding="utf-8") as handle:
-        rows = list(csv.DictReader(handle))
-    return [{k: _from_csv(v) for k, v in row.items()} for row in rows]
+    from .inputs import read_text
+    from .measured import csv_rows
+
+    rows = csv_rows(read_text(path, "results").splitlines(keepends=True), str(path))
+    if not rows:
+        return []
+    header = rows[0]
+    return [{k: _from_csv(v) for k, v in zip(header, row)} for row in rows[1:] if row]
 
 
 def _from_csv(text):
@@ -232,16 +238,37 @@ def journal_path(out: Path) -> Path:
     return out.with_name(out.name + ".partial")
 
 
+#: the first line of a batch journal: a file of that name without it is not ours
+JOURNAL_HEADER = json.dumps({"gfe_opt_batch_journal": 1})
+
+
 def _read_journal(path: Path) -> list[dict]:
+    """The rows of this batch's journal (refused if the file is a link or not a journal)."""
     rows = []
-    if not path.exists():
+    if not (path.exists() or path.is_symlink()):
         return rows
-    for line in path.read_text(encoding="utf-8", errors="replace").splitlines():
+    with open_own(path, JOURNAL_HEADER) as handle:
+        text = handle.read()
+    for line in text.splitlines():
         try:
-            rows.append(json.loads(line))
+            row = json.loads(line)
         except json.JSONDecodeError:
             continue  # a line cut short by a crash: that set runs again
+        if isinstance(row, dict) and "file" in row:
+            rows.append(row)
     return rows
+
+
+def _check_batch_outputs(out: Path, journal: Path, inputs) -> None:
+    """Before any work: the table and its journal are ordinary paths of their own, neither
+    an input (the model, a measured file of the folder) nor a link; an existing table is
+    resumed or, with --force, replaced (gfe_opt.outputs)."""
+    check_output_path(out, True, inputs, where="--out")
+    check_output_path(journal, True, inputs, where="--out (its journal)")
+    if out.is_symlink():
+        raise GfeInputError("--out", str(out), "is a link: give the table's own path")
+    if journal.is_symlink():
+        raise GfeInputError("--out", str(journal), "(the batch's journal) is a link; remove it")
 
 
 # -------------------------------------------------------------------------------------------
@@ -299,16 +326,19 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
                 freq_noise, shape_noise)
     files = measured_files(folder)
     journal = journal_path(out)
-    if force:
-        for path in (out, journal):
-            if path.exists():
-                path.unlink()
+    _check_batch_outputs(out, journal, [Path(model_path), *files])
     done = []
-    if out.exists():
-        if not out.is_file():
-            raise GfeInputError("--out", str(out), "exists and is not a file")
-        done = read_table(out)
-    done += _read_journal(journal)
+    if force:
+        if journal.exists():
+            open_own(journal, JOURNAL_HEADER).close()  # only this batch's own journal goes
+            journal.unlink()
+    else:
+        if out.exists():
+            done = read_table(out)
+        done += _read_journal(journal)
+    if any("file" not in r or "model_sha1" not in r for r in done):
+        raise GfeInputError("--out", str(out), "exists and is not a gfe-opt batch table; give "
+                            "a new --out, or --force to replace it")
     other = [r for r in done if r.get("model_sha1") != task.model_sha1
              or r.get("task") != task.label]
     if other:
@@ -326,8 +356,13 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
     kept = [r for r in by_key.values() if r["file"] in names_now]
     skipped = len(kept)
     new_rows = []
+    log = (open_own(journal, JOURNAL_HEADER) if journal.exists()
+           else create_exclusive(journal, JOURNAL_HEADER))
+    if log is None:
+        raise GfeInputError("--out", str(journal), "appeared while the batch started (another "
+                            "batch with this --out?); run one batch per table")
     try:
-        with open(journal, "a", encoding="utf-8") as log:
+        with log:
             for row in _execute(task, todo, scheduler, workers, progress, skipped):
                 row = _plain(row)
                 log.write(json.dumps(row, allow_nan=False) + "\n")
@@ -338,8 +373,8 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
         rows = _clean(kept + new_rows)
         if rows:
             write_table(rows, out)
-        if journal.exists() and (len(new_rows) == len(todo) and rows
-                                 or journal.stat().st_size == 0):
+        if journal.is_file() and not journal.is_symlink() and (
+                len(new_rows) == len(todo) and rows or not new_rows):
             journal.unlink()  # all in the table, or nothing was written
     failed = sum(1 for r in rows if r["status"] != "ok")
     return BatchResult(sorted(rows, key=lambda r: r["file"]), len(new_rows), skipped, failed,

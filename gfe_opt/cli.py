@@ -228,7 +228,7 @@ def _figures(build, *args) -> dict:
         raise GfeInputError("--plot/--report", None, str(exc)) from None
 
 
-COMPARE_FIGURES = ("mac.png", "frequencies.png", "localisation.png")
+from .report import COMPARE_FIGURES, DIAGNOSIS_FIGURES  # noqa: E402
 
 
 def _comparison_report(report, result, model, measured):
@@ -276,6 +276,12 @@ def cmd_modes(args) -> int:
     model = load_model(args.model)
     if args.modes < 1:
         raise GfeInputError("--modes", None, f"must be >= 1, got {args.modes}")
+    from .inputs import MAX_SENSORS
+
+    if len(model.nodes) > MAX_SENSORS + 2:  # a value at every node (supports may drop two)
+        raise GfeInputError("--out", str(args.out), f"would hold shapes at {len(model.nodes)} "
+                            f"nodes, above the {MAX_SENSORS} sensors a measured file may "
+                            "have: use a model of fewer elements for a measured file")
     disc = discretise(model)
     rigid = rigid_body_count(disc)
     if args.modes + rigid > len(disc.free) - 1:
@@ -327,8 +333,6 @@ def cmd_diagnose(args) -> int:
     return 0
 
 
-DIAGNOSIS_FIGURES = ("candidates.png", "stiffness_change.png", "disturbance.png",
-                     "nodal_equations.png")
 
 
 def cmd_update(args) -> int:
@@ -473,10 +477,15 @@ def main(argv=None) -> int:
             return int(exc.code or 0)
         args.argv = argv
         with np.errstate(all="ignore"):
-            return {"compare": cmd_compare, "diagnose": cmd_diagnose, "update": cmd_update,
-                    "modes": cmd_modes, "identify": cmd_identify,
-                    "batch": cmd_batch, "trend": cmd_trend,
-                    "demo": cmd_demo}[args.command](args)
+            from .outputs import replacing
+
+            # an output that did not exist at the checks is claimed, not replaced, unless
+            # --force: of two runs writing one new file, one wins
+            with replacing(bool(getattr(args, "force", False))):
+                return {"compare": cmd_compare, "diagnose": cmd_diagnose,
+                        "update": cmd_update, "modes": cmd_modes, "identify": cmd_identify,
+                        "batch": cmd_batch, "trend": cmd_trend,
+                        "demo": cmd_demo}[args.command](args)
     except GfeInputError as exc:
         print(f"gfe-opt: error: {_one_line(exc)}", file=sys.stderr)
         return 2

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 from .correlation import compare
@@ -10,9 +9,17 @@ from .diagnosis import diagnose, update
 from .errors import GfeInputError
 from .measured import save_measured
 from .model import Effect, load_model, save_model
+from .outputs import atomic_write
 from .plots import error_history
 from .problems import problem_file
-from .report import Report, compare_figures, diagnosis_figures, save_figures
+from .report import (
+    COMPARE_FIGURES,
+    DIAGNOSIS_FIGURES,
+    Report,
+    compare_figures,
+    diagnosis_figures,
+    save_figures,
+)
 from .synthetic import interior_sensors, synthetic_measurement
 from .text import (
     format_comparison,
@@ -33,7 +40,10 @@ def _indent(text: str) -> str:
 
 
 MARKER = ".gfe-opt-demo.json"
-DEMO_FILES = ("model.toml", "measured.json", "updated.toml", "report.html")
+#: every file the demo may write: a second demo replaces them only as the first wrote them
+DEMO_FILES = ("model.toml", "measured.json", "updated.toml", "report.html",
+              *(f"figures/{name}" for name in (*COMPARE_FIGURES, *DIAGNOSIS_FIGURES,
+                                                "error.png")))
 
 
 def _sha1(path: Path) -> str:
@@ -56,18 +66,28 @@ def check_demo_folder(out: Path) -> None:
             written = {}
     for name in DEMO_FILES:
         path = out / name
-        if path.exists() and (not path.is_file() or written.get(name) != _sha1(path)):
+        if path.is_symlink() or path.exists() and (not path.is_file()
+                                                   or written.get(name) != _sha1(path)):
             raise GfeInputError(str(path), None, "exists and is not as the demo wrote it; "
                                 "pass --force to overwrite it, or choose another --out")
+
+
+def check_demo_force(out: Path) -> None:
+    """With --force the demo replaces files, never anything else at their names (a folder,
+    a FIFO): such a path is refused before any work.  A link is replaced by the file, its
+    target left as it was."""
+    from .outputs import check_output_path
+
+    for name in DEMO_FILES:
+        check_output_path(out / name, True, (), where="--out")
 
 
 def _mark_demo_folder(out: Path) -> None:
     import json
 
-    from .outputs import atomic_write
-
     hashes = {name: _sha1(out / name) for name in DEMO_FILES if (out / name).is_file()}
-    atomic_write(out / MARKER, lambda tmp: Path(tmp).write_text(json.dumps(hashes, indent=1)))
+    atomic_write(out / MARKER, lambda tmp: Path(tmp).write_text(json.dumps(hashes, indent=1)),
+                 replace=True)
 
 
 def demo_measurement(model=None):
@@ -82,12 +102,21 @@ def demo_measurement(model=None):
 
 
 def run_demo(out: Path, force: bool = False) -> int:
+    """The demo into ``out``; its files (figures included) are checked first: without
+    ``force`` each must be absent or as an earlier demo wrote it, and is then replaced."""
+    from .outputs import replacing
+
+    check_demo_folder(out) if not force else check_demo_force(out)
+    with replacing(True):
+        return _run_demo(out)
+
+
+def _run_demo(out: Path) -> int:
     model_path, measured_path = out / "model.toml", out / "measured.json"
     updated_path, report_path = out / "updated.toml", out / "report.html"
-    if not force:
-        check_demo_folder(out)
     out.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(problem_file("ss-steel-beam.toml"), model_path)
+    source = problem_file("ss-steel-beam.toml").read_bytes()
+    atomic_write(model_path, lambda tmp: tmp.write_bytes(source), replace=True)
     model = load_model(model_path)
     print("gfe-opt demo: a model that disagrees with a modal test\n")
     print(f"1. The model ({model_path}): a simply supported steel beam, "

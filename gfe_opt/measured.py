@@ -147,6 +147,11 @@ def make_measured(x, dof, frequencies_hz, shapes, source="measured",
         # shapes have any scale: each mode to a largest amplitude of 1 before any product
         # (1e300 squared overflows, 1e-320 squared underflows)
         shapes = shapes / np.max(np.abs(shapes), axis=0)
+    if x.size:
+        # sensors in position order, whatever the file's: everything drawn or read along
+        # the structure (sparkline, "also near", plots) follows them
+        along = np.argsort(x, kind="stable")
+        x, shapes = x[along], shapes[along]
     if damping is not None:
         damping = np.asarray(damping, dtype=float)
         if damping.shape != f.shape:
@@ -166,7 +171,20 @@ def make_measured(x, dof, frequencies_hz, shapes, source="measured",
                          damping=damping)
 
 
+def _numbers_only(values) -> bool:
+    """True when ``values`` (nested lists or an array) hold numbers only: no strings or
+    booleans (``np.asarray(..., float)`` would take "0.1" and true)."""
+    if isinstance(values, np.ndarray):
+        return values.dtype.kind in "iuf"
+    if isinstance(values, (list, tuple)):
+        return all(_numbers_only(v) for v in values)
+    return isinstance(values, (int, float, np.integer, np.floating)) and not isinstance(
+        values, (bool, np.bool_))
+
+
 def _finite_array(values, source, field, ndim):
+    if not _numbers_only(values):
+        raise GfeInputError(source, field, "must hold numbers only (no text or true/false)")
     try:
         arr = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
@@ -290,11 +308,22 @@ def _is_number(v):
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
+def csv_rows(lines, where: str) -> list[list[str]]:
+    """Rows of CSV text; a field over the csv module's limit (131 072 characters) or a
+    malformed quote is one line naming the file and the row, not an internal error."""
+    reader = csv.reader(lines)
+    try:
+        return list(reader)
+    except csv.Error as exc:
+        raise GfeInputError(where, f"row {reader.line_num}", f"not readable as CSV ({exc})"
+                            ) from None
+
+
 def _read_csv(path: Path, dof: str) -> MeasuredModes:
     where = str(path)
     lines = [ln for ln in read_text(path, "measured").splitlines()
              if ln.strip() and not ln.lstrip().startswith("#")]
-    rows = list(csv.reader(lines))
+    rows = csv_rows(lines, where)
     if not rows:
         raise GfeInputError(where, None, "needs a header row of frequencies (and sensor rows)")
     header = rows[0]
@@ -434,7 +463,8 @@ def save_measured(m: MeasuredModes, path, *, force: bool = False, protect=()) ->
     suffix = path.suffix.lower()
     if suffix == ".json":
         text = json.dumps(measured_to_dict(m), indent=1)
-        atomic_write(path, lambda p: p.write_text(text + "\n", encoding="utf-8"))
+        atomic_write(path, lambda p: p.write_text(text + "\n", encoding="utf-8"),
+                     replace=force)
     elif suffix == ".csv":
         def write(p):
             with open(p, "w", newline="", encoding="utf-8") as fh:
@@ -442,12 +472,12 @@ def save_measured(m: MeasuredModes, path, *, force: bool = False, protect=()) ->
                 w.writerow(["x"] + [repr(float(f)) for f in m.frequencies_hz])
                 for i, x in enumerate(m.x):
                     w.writerow([repr(float(x))] + [repr(float(v)) for v in m.shapes[i]])
-        atomic_write(path, write)
+        atomic_write(path, write, replace=force)
     elif suffix in (".uff", ".unv"):
         if not m.n_sensors:
             raise GfeInputError(str(path), None, "modes without shapes cannot be written as "
                                 "UFF dataset 55 (it holds shapes at nodes): use .json or .csv")
-        atomic_write(path, lambda p: _write_uff(m, p))
+        atomic_write(path, lambda p: _write_uff(m, p), replace=force)
     else:
         raise GfeInputError(str(path), None, f"unknown measured-data format {suffix!r}")
 

@@ -360,4 +360,4 @@ def save_model(model: Model, path, *, force: bool = False, protect=()) -> None:
 
     check_output_path(path, force, protect, kind="model")
     text = tomli_w.dumps(model_to_dict(model))
-    atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"))
+    atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"), replace=force)

@@ -78,6 +78,12 @@ def update_figures(outcome) -> dict:
                                                outcome.after.freq_error_rms_pct)])}
 
 
+#: the figures a command may write (checked before any work)
+COMPARE_FIGURES = ("mac.png", "frequencies.png", "localisation.png")
+DIAGNOSIS_FIGURES = ("candidates.png", "stiffness_change.png", "disturbance.png",
+                     "nodal_equations.png")
+
+
 def save_figures(figs: dict, folder) -> list[Path]:
     """Write every figure as PNG into ``folder``; returns the paths."""
     return [plots.save(fig, Path(folder) / name) for name, fig in figs.items()]

@@ -40,6 +40,20 @@ def _ratio(value: float) -> str:
     return f"{value:.3g}" if value < 1000 else f"{value:.0f}"
 
 
+#: the widest sparkline (one terminal line with its frame and indent)
+SPARK_WIDTH = 72
+
+
+def sparkline(values, width: int = SPARK_WIDTH) -> str:
+    """Values in [0, 1] as block characters, at most ``width`` of them: more values share a
+    character, which shows their largest (a peak is never averaged away)."""
+    v = np.asarray(values, dtype=float)
+    if v.size > width:
+        edges = np.linspace(0, v.size, width + 1).round().astype(int)
+        v = np.array([v[a:b].max() for a, b in zip(edges[:-1], edges[1:])])
+    return "".join(SPARK[int(round(x * (len(SPARK) - 1)))] for x in v)
+
+
 def format_comparison(result, length: float) -> str:
     """Paired modes and where along the structure the model fails."""
     lines = [f"{'mode':>4}  {'f_test [Hz]':>12}  {'f_model [Hz]':>12}  {'Δf %':>8}  {'MAC':>6}"]
@@ -59,8 +73,7 @@ def format_comparison(result, length: float) -> str:
         lines.append("no residual force: the model reproduces the measured shapes")
         lines.extend(f"note: {n}" for n in result.notes)
         return "\n".join(lines)
-    r = result.residual / result.residual.max()
-    spark = "".join(SPARK[int(round(v * (len(SPARK) - 1)))] for v in r)
+    spark = sparkline(result.residual / result.residual.max())
     lines.append("residual force along the structure (left end -> right end):")
     lines.append(f"  |{spark}|")
     x0, _ = places[0]

@@ -81,6 +81,7 @@ def test_a_read_only_file_system_is_one_line(files, capsys, tmp_path, monkeypatc
         raise OSError(30, "Read-only file system")
 
     monkeypatch.setattr(os, "replace", refuse)
+    monkeypatch.setattr(os, "link", refuse)
     _fails(capsys, ["update", str(model), str(measured), "--add", "material",
                     "--out", str(tmp_path / "u.toml")], "cannot write (Read-only file system)")
     assert not list(tmp_path.iterdir())  # no temporary file left either
