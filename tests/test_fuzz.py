@@ -90,7 +90,7 @@ def byte_mutation(draw, text: str) -> bytes:
     data = bytearray(text.encode())
     for _ in range(draw(st.integers(1, 3))):
         op = draw(st.sampled_from(["flip", "delete", "insert", "truncate", "duplicate",
-                                   "utf16", "latin1", "bom", "empty", "nul"]))
+                                   "utf16", "latin1", "bom", "empty", "nul", "wide"]))
         i = draw(st.integers(0, max(len(data) - 1, 0)))
         if op == "flip" and data:
             data[i] ^= 1 << draw(st.integers(0, 7))
@@ -113,6 +113,8 @@ def byte_mutation(draw, text: str) -> bytes:
             data = bytearray()
         elif op == "nul":
             data[i:i] = b"\0"
+        elif op == "wide":  # a field past the csv module's 131 072 characters
+            data[i:i] = b'"' + b"1" * draw(st.sampled_from([131_073, 140_000])) + b'"'
     return bytes(data)
 
 
@@ -236,4 +238,42 @@ def test_mutated_options_never_crash(seeds, tmp_path, data):
             value = data.draw(st.sampled_from(VALUES))
             args.append(str(tmp_path / value) if value in ("out.toml", "out.json", "figs",
                                                            "r.html") else value)
+    _check(*_run(args, tmp_path))
+
+
+def _table_seed() -> str:
+    """A small batch table as ``gfe-opt batch`` writes it (CSV): four sets, a crack growing."""
+    import tempfile
+    from pathlib import Path
+
+    from gfe_opt.batch import FIXED_COLUMNS, write_table
+
+    rows = []
+    for i in range(4):
+        row = dict.fromkeys(FIXED_COLUMNS)
+        row.update(file=f"set-{i}.json", sha1="0" * 40, time=f"2026-01-0{i + 1}T00:00",
+                   task="update material+crack", model_sha1="1" * 40, status="ok",
+                   freq_error_before_pct=0.5 + i, freq_error_after_pct=0.04,
+                   **{"material.E": 2.06e11 * (1 + 0.001 * i), "material.E.sigma": 1e8,
+                      "crack.depth_ratio": 0.1 * i, "crack.depth_ratio.sigma": 0.01,
+                      "crack.size_sigmas": 10.0 * i})
+        rows.append(row)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "table.csv"
+        write_table(rows, path)
+        return path.read_text()
+
+
+TABLE = _table_seed()
+
+
+@settings(deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_mutated_batch_tables_never_crash(tmp_path, data):
+    """``gfe-opt trend`` on a mutated batch table (issue 23: a field over the CSV limit or a
+    table that is not UTF-8 ended in an internal error)."""
+    path = tmp_path / "table.csv"
+    path.write_bytes(data.draw(byte_mutation(TABLE)))
+    args = ["trend", str(path)] + (["--json"] if data.draw(st.booleans()) else [])
     _check(*_run(args, tmp_path))
