@@ -147,6 +147,9 @@ def expand_modes(disc: Discretisation, C, omega, shapes, noise: float = DEFAULT_
                 G = 0.5 * (G + G.T)
                 lam = _tikhonov_discrepancy(G, y, noise)
                 phi = X @ lam
+            elif Cf.shape[0] * Cf.shape[1] <= LOW_RANK_LIMIT:
+                # many sensors on a coarse model: G has rank <= n_free, solved in that space
+                phi, lam = _tikhonov_low_rank(lu, Cf, y, noise)
             else:  # many sensors: the same solution from a sparse system, memory O(n)
                 phi, lam = _tikhonov_sparse(D, Cf, y, noise)
         out_shapes[free, j] = phi
@@ -159,6 +162,44 @@ def expand_modes(disc: Discretisation, C, omega, shapes, noise: float = DEFAULT_
 #: above this many sensors the expansion avoids dense sensor x sensor and DOF x sensor
 #: matrices (a sensor at every node of a fine mesh)
 DENSE_SENSOR_LIMIT = 200
+
+
+#: sensors x free DOFs up to which many sensors are expanded through the thin QR of C
+#: (4 000 000 values, 32 MB): 5 000 sensors on a 46-element beam
+LOW_RANK_LIMIT = 4_000_000
+
+
+def _tikhonov_low_rank(lu, C, y, noise):
+    r"""The Tikhonov expansion of :func:`_tikhonov_discrepancy` for many sensors on a model
+    with few DOFs: with the thin QR C = QR (Q: sensors × DOFs), G = C D⁻¹ Cᵀ = Q H Qᵀ with
+    H = R D⁻¹ Rᵀ, so its eigenpairs come from the small H (G has rank ≤ the DOFs however
+    many sensors there are) and the discrepancy search costs nothing per α.  The same
+    solution as the dense and sparse routes (the part of y outside the range of Q is misfit
+    no α removes).  Returns (φ, λ)."""
+    Q, R = np.linalg.qr(C.toarray())
+    H = R @ lu.solve(np.ascontiguousarray(R.T))
+    w, V = np.linalg.eigh(0.5 * (H + H.T))
+    U = Q @ V
+    beta = U.T @ y
+    outside = float(np.sum((y - U @ beta) ** 2))
+    target = noise * np.max(np.abs(y)) * np.sqrt(y.size)
+    a = np.abs(w)
+
+    def misfit(alpha):
+        return np.sqrt(np.sum((alpha**2 / (a**2 + alpha**2) * beta) ** 2) + outside)
+
+    lo, hi = a.min() * 1e-6 + 1e-300, a.max() * 1e3
+    if noise <= 0 or misfit(lo) >= target:
+        alpha = lo
+    else:
+        for _ in range(200):
+            mid = np.sqrt(lo * hi)
+            lo, hi = (mid, hi) if misfit(mid) < target else (lo, mid)
+            if hi / lo < 1 + 1e-6:
+                break
+        alpha = np.sqrt(lo * hi)
+    lam = U @ (w / (w**2 + alpha**2) * beta)
+    return lu.solve(C.T @ lam), lam
 
 
 def _tikhonov_sparse(D, C, y, noise):

@@ -57,8 +57,12 @@ def write_examples(folder: Path) -> list[Path]:
     return paths + [path]
 
 
-#: shipped and regenerated values agree to this fraction of their array's largest magnitude
-CHECK_RTOL = 1e-7
+#: shipped and regenerated values agree to this fraction of their array's largest magnitude:
+#: an FRF near a resonance amplifies its natural frequency's rounding (~1e-9 between BLAS
+#: kernels) by 1/ζ (200 at ζ = 0.5 %): 2e-7 of the largest was seen between SkylakeX and
+#: Sandybridge; 50 times that is still 500 times below the 0.5 % noise the files carry, which
+#: any change of the code that makes them moves by more
+CHECK_RTOL = 1e-5
 
 
 def _arrays(path: Path) -> dict:

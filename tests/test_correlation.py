@@ -67,3 +67,34 @@ def test_compare_of_a_correct_model_shows_small_errors_everywhere():
     assert result.freq_error_rms_pct < 1e-3 and result.mac_mean > 1 - 1e-8
     # with exact data the residual at the sensors is the discretisation error only
     assert result.residual.max() < 1e-3
+
+
+def test_many_sensors_low_rank_expansion_is_the_sparse_one():
+    """5 000 sensors on a 46-element beam (issue 23: diagnose took minutes): G = C D⁻¹ Cᵀ has
+    rank <= the free DOFs, so the Tikhonov expansion is solved in that space; it is the
+    sparse route's solution to the sparse route's own α tolerance."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from gfe_opt import correlation
+    from gfe_opt.assembly import discretise
+    from gfe_opt.measured import sensor_matrix
+
+    model = make_model()
+    disc = discretise(model)
+    K, M = disc.global_matrices()
+    free = disc.free
+    Kf, Mf = sp.csc_matrix(K)[free][:, free], sp.csc_matrix(M)[free][:, free]
+    x = np.linspace(0.001, model.length - 0.001, 5000)
+    Cf = sp.csr_matrix(sensor_matrix(model.nodes, "beam", x, "w", "many"))[:, free]
+    rng = np.random.default_rng(4)
+    for mode in (1, 3):
+        omega = (mode * np.pi / model.length) ** 2 * np.sqrt(model.bending_rigidity
+                                                             / model.mass_per_length) * 1.01
+        y = np.sin(mode * np.pi * x / model.length) + 0.003 * rng.standard_normal(x.size)
+        D = (Kf - omega**2 * Mf).tocsc()
+        phi, lam = correlation._tikhonov_low_rank(spla.splu(D), Cf, y, 0.003)
+        phi_s, lam_s = correlation._tikhonov_sparse(D, Cf, y, 0.003)
+        assert np.max(np.abs(phi - phi_s)) < 1e-4 * np.max(np.abs(phi_s))
+        misfit = np.linalg.norm(Cf @ phi - y) / (0.003 * np.max(np.abs(y)) * np.sqrt(x.size))
+        assert abs(misfit - 1.0) < 1e-4   # the discrepancy principle holds
