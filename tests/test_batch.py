@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import tomli_w
 
-from gfe_opt.batch import FIXED_COLUMNS, journal_path, read_table, run_batch
+from gfe_opt.batch import FIXED_COLUMNS, JOURNAL_HEADER, journal_path, read_table, run_batch
 from gfe_opt.cli import main
 from gfe_opt.fitting import misfit, noise_of
 from gfe_opt.measured import load_measured
@@ -100,13 +100,15 @@ def test_killed_batch_resumes_to_the_same_table(campaign, tmp_path):
     journal = journal_path(out)
     deadline = time.time() + 120
     while time.time() < deadline:
-        if journal.exists() and journal.read_text().count("\n") >= 3:
+        if journal.exists() and journal.read_text().count("\n") >= 4:  # header + 3 rows
             break
         time.sleep(0.05)
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
     assert not out.exists()
-    done = journal.read_text().count("\n")
+    lines = journal.read_text().splitlines()
+    assert lines[0] == JOURNAL_HEADER
+    done = len(lines) - 1
     assert 3 <= done < N_SETS
     with open(journal, "a") as handle:
         handle.write('{"file": "set-00')  # a line cut short by the kill
