@@ -188,16 +188,7 @@ def _tikhonov_low_rank(lu, C, y, noise):
     def misfit(alpha):
         return np.sqrt(np.sum((alpha**2 / (a**2 + alpha**2) * beta) ** 2) + outside)
 
-    lo, hi = a.min() * 1e-6 + 1e-300, a.max() * 1e3
-    if noise <= 0 or misfit(lo) >= target:
-        alpha = lo
-    else:
-        for _ in range(200):
-            mid = np.sqrt(lo * hi)
-            lo, hi = (mid, hi) if misfit(mid) < target else (lo, mid)
-            if hi / lo < 1 + 1e-6:
-                break
-        alpha = np.sqrt(lo * hi)
+    alpha = _discrepancy_alpha(misfit, a.min() * 1e-6 + 1e-300, a.max() * 1e3, target, noise)
     lam = U @ (w / (w**2 + alpha**2) * beta)
     return lu.solve(C.T @ lam), lam
 
@@ -268,17 +259,21 @@ def _tikhonov_discrepancy(G, y, noise):
     def misfit(alpha):
         return np.linalg.norm(alpha**2 / (s**2 + alpha**2) * beta)
 
-    lo, hi = s[-1] * 1e-6 + 1e-300, s[0] * 1e3
-    if noise <= 0 or misfit(lo) >= target:
-        alpha = lo
-    else:
-        for _ in range(200):
-            mid = np.sqrt(lo * hi)
-            lo, hi = (mid, hi) if misfit(mid) < target else (lo, mid)
-            if hi / lo < 1 + 1e-6:
-                break
-        alpha = np.sqrt(lo * hi)
+    alpha = _discrepancy_alpha(misfit, s[-1] * 1e-6 + 1e-300, s[0] * 1e3, target, noise)
     return vt.T @ (s / (s**2 + alpha**2) * beta)
+
+
+def _discrepancy_alpha(misfit, lo, hi, target, noise):
+    """α in [lo, hi] with ``misfit(α)`` (rising with α) equal to ``target``: bisection on
+    log α to 1e-6; ``lo`` when there is no noise or even ``lo`` misfits by more."""
+    if noise <= 0 or misfit(lo) >= target:
+        return lo
+    for _ in range(200):
+        mid = np.sqrt(lo * hi)
+        lo, hi = (mid, hi) if misfit(mid) < target else (lo, mid)
+        if hi / lo < 1 + 1e-6:
+            break
+    return np.sqrt(lo * hi)
 
 
 def check_model_size(disc: Discretisation, measured: MeasuredModes, where: str = "model"
