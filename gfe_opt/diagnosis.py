@@ -503,7 +503,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         f.failed = no_gain or not f.success
         if f.failed:
             f.notes.append(f"at best χ²/n {f.misfit.chi2_per_residual:.4g}, no better than "
-                           "without it" if no_gain else f"solver: {f.status}")
+                           "without it" if no_gain else
+                           f"the fit did not converge (last IPOPT status {f.status})")
     sel = _Selection(ref_misfit.chi2, ref_params, len(fits) + len(fallback_names),
                      measured.n_modes)
     sel.floor = _floor([*fits, reference])
@@ -947,7 +948,8 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     fit = fit_effects(model, measured, starts, noise=noise, C=C,
                       name=" + ".join(e.name for e in effects))
     if not fit.success:
-        raise GfeSolverError(f"IPOPT did not fit the effects ({fit.status})")
+        raise GfeSolverError(f"the fit of the effects did not converge (last IPOPT status "
+                             f"{fit.status})")
     return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit,
                          added=list(range(len(model.effects), len(fit.effects))),
                          notes=[*dropped, *equivalent_notes(fit, measured)])

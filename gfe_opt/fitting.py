@@ -21,7 +21,10 @@ side, a profile's knots) are fixed.  Instances already in the model start where 
 added ones start from given values or from the best point of a coarse grid.  χ² is
 minimised by IPOPT through CasADi: the objective ½‖r‖², its gradient Jᵀr and the
 Gauss–Newton Hessian JᵀJ come from one forward-difference Jacobian J per point (small
-callbacks: IPOPT sees n × n matrices, however many residuals there are).
+callbacks: IPOPT sees n × n matrices, however many residuals there are).  IPOPT finds the
+valley; :func:`_finish` then converges to the optimum by a scale-free rule (the Newton
+decrement below 1e-9 noise floors), so that machines whose arithmetic differs in the last
+bits end at the same point; a fit whose finish does not settle has failed.
 
 Uncertainty
 -----------
@@ -507,8 +510,8 @@ def _minimise(residual, chi2, z_start, lower, upper, max_iter):
     return z, value, status, outcome != "not_converged"
 
 
-#: the finish stops when a full Gauss–Newton step would lower χ² by less than this many
-#: noise-floor units: the parameters are then within √FINISH_DECREMENT ≈ 3e-5 of their
+#: the finish stops when a full Newton (and Gauss–Newton) step would lower χ² by less than
+#: this many noise-floor units: the parameters are then within √FINISH_DECREMENT ≈ 3e-5 of their
 #: standard deviation from the optimum, far below any printed digit or any decision margin
 FINISH_DECREMENT = 1e-9
 #: a finish that cannot meet :data:`FINISH_DECREMENT` (no step lowers χ² any more, or its
