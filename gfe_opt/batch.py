@@ -178,8 +178,9 @@ def read_table(path) -> list[dict]:
     rows = csv_rows(read_text(path, "results").splitlines(keepends=True), str(path))
     if not rows:
         return []
-    header = rows[0]
-    return [{k: _from_csv(v) for k, v in zip(header, row)} for row in rows[1:] if row]
+    header = rows[0]  # a short row's missing cells are None, as csv.DictReader gave them
+    return [{**dict.fromkeys(header), **{k: _from_csv(v) for k, v in zip(header, row)}}
+            for row in rows[1:] if row]
 
 
 def _from_csv(text):

@@ -106,7 +106,10 @@ def run_demo(out: Path, force: bool = False) -> int:
     ``force`` each must be absent or as an earlier demo wrote it, and is then replaced."""
     from .outputs import replacing
 
-    check_demo_folder(out) if not force else check_demo_force(out)
+    if force:
+        check_demo_force(out)
+    else:
+        check_demo_folder(out)
     with replacing(True):
         return _run_demo(out)
 

@@ -529,20 +529,7 @@ FINISH_RANK = 1e-4
 SOLVER_TALLY: Counter = Counter()
 
 
-def _jacobian(residual, z, r, lower, upper, step: float = 1e-6):
-    """Forward-difference Jacobian of the residuals, stepping inwards at an upper bound."""
-    J = np.empty((r.size, z.size))
-    for k in range(z.size):
-        h = step * max(1.0, abs(z[k]))
-        if z[k] + h > upper[k]:
-            h = -h
-        dz = z.copy()
-        dz[k] += h
-        J[:, k] = (residual(dz) - r) / h
-    return J
-
-
-def _jacobian2(residual, z, r, lower, upper, step: float = 1e-5):
+def _jacobian(residual, z, r, lower, upper, step: float = 1e-5):
     """Second-order difference Jacobian (central; at a bound the one-sided three-point
     formula, stepping inwards): errors of ~1e-10 where forward differences err by 1e-6 times
     a residual's curvature-to-slope ratio, enough for the finish to certify its rule on
@@ -570,7 +557,7 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     stop at the same point to far below the printed digits.
 
     Steps are damped Newton steps on χ² with the Hessian JᵀJ + S: J the second-order
-    difference Jacobian (:func:`_jacobian2`), S the second-order term Σ rᵢ∇²rᵢ built up by
+    difference Jacobian (:func:`_jacobian`), S the second-order term Σ rᵢ∇²rᵢ built up by
     the structured secant update of Dennis, Gay & Welsch (NL2SOL; it matters when the
     residuals are large: a fit that does not reach the noise zig-zagged for 60 Gauss–Newton
     steps).  The fit has converged when
@@ -587,7 +574,7 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     value = float(r @ r)
     if n == 0 or not np.isfinite(value) or value >= FAILED_RESIDUAL**2:
         return z, value, 0.0 if n == 0 else np.inf
-    J = _jacobian2(residual, z, r, lower, upper)
+    J = _jacobian(residual, z, r, lower, upper)
     d = np.linalg.norm(J, axis=0)
     d = np.where(d > 0, d, 1.0)   # fixed scaling: u = d z
     S = np.zeros((n, n))          # Σ rᵢ∇²rᵢ in the scaled variables (secant estimate)
@@ -631,7 +618,7 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
         if not accepted:  # no step lowers χ²: the optimum as far as rounding can tell
             return z, value, decrement / floor
         lam = 0.0 if lam <= 1e-6 else lam / 10.0
-        J_new = _jacobian2(residual, trial, r_trial, lower, upper)
+        J_new = _jacobian(residual, trial, r_trial, lower, upper)
         S = _secant(S, (trial - z) * d, J / d, J_new / d, r_trial, g)
         z, r, value, J = trial, r_trial, trial_value, J_new
     return z, value, decrement / floor
@@ -661,7 +648,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper) -> list[dic
     r0 = residual(z)
     # second-order differences: forward ones (step 1e-6) gave σ that moved by 1e-3 between
     # two optima 1e-4 σ apart (a section loss on the demo), a printed digit at 99.95 σ
-    J = _jacobian2(residual, z, r0, lower, upper, step=1e-4)
+    J = _jacobian(residual, z, r0, lower, upper, step=1e-4)
     A = J.T @ J
     ridge = 1e-12 * max(float(np.max(np.diag(A))), 1e-300)
     s2 = max(1.0, fit_misfit.chi2 / max(fit_misfit.n_residuals - n, 1))
