@@ -54,6 +54,9 @@ class Discretisation:
     nodal_stiffness: tuple
     constrained: np.ndarray
     eigenvalue_scale: float
+    #: Timoshenko g = 12EI/(κGAL²) per element (None: Euler–Bernoulli); sensors between
+    #: nodes are interpolated with it (:func:`~gfe_opt.elements.timoshenko_deflection`)
+    shear_g: np.ndarray | None = None
 
     @property
     def n_elements(self) -> int:
@@ -213,7 +216,7 @@ class Builder:
         size = 4 if beam else 2
         E = model.youngs_modulus
         rigidity = E * (model.inertia if beam else model.area)
-        params = self._stiffness(rigidity)
+        params, shear_g = self._stiffness(rigidity)
         mass = self._mass(E)
         constrained = set(constrained_dofs(model).tolist())
         extra = np.zeros((n, size, size))
@@ -237,7 +240,7 @@ class Builder:
                               stiffness_params=params, mass=mass, extra_stiffness=extra,
                               nodal_stiffness=tuple(nodal),
                               constrained=np.array(sorted(constrained), dtype=int),
-                              eigenvalue_scale=scale)
+                              eigenvalue_scale=scale, shear_g=shear_g)
 
     def _shape_at(self, x):
         """Element index and shape functions (physical DOFs) at position x."""
@@ -255,17 +258,18 @@ class Builder:
             k = np.full(n, rigidity)
             for elements, _, w, x in _quadrature(model, self.rigidity):
                 k[elements] = L / np.sum(w / (rigidity * _product(self.rigidity, x)), axis=-1)
-            return {"k": k}
+            return {"k": k}, None
         out = {k: np.full(n, v) for k, v in el.euler_bernoulli_stiffness(rigidity).items()}
         for elements, s, w, x in _quadrature(model, self.rigidity):
             c = w / (rigidity * _product(self.rigidity, x))
             k_ww, k_wt, k_tt = el.flexibility_parameters(s, c, L)
             out["k_ww"][elements], out["k_wt"][elements], out["k_tt"][elements] = (
                 k_ww, k_wt, k_tt)
+        g = None
         if self.shear_rigidity is not None:
             g = el.shear_parameter(out["k_ww"] / 12.0, self.shear_rigidity, L)
             out = el.timoshenko_correction(out, g)
-        return out
+        return out, g
 
     def _mass(self, E: float) -> np.ndarray:
         model = self.model

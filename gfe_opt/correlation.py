@@ -33,7 +33,7 @@ from scipy.optimize import linear_sum_assignment
 
 from .assembly import Discretisation, discretise
 from .errors import GfeInputError, GfeSolverError
-from .measured import MeasuredModes, on_model, sensor_matrix
+from .measured import MeasuredModes, observation, on_model
 from .modal import Modes, discretisation_modes, rigid_body_count
 from .model import Model
 
@@ -405,7 +405,7 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
     disc = discretise(model) if disc is None else disc
     measured, dropped = on_model(measured, model)
     check_model_size(disc, measured, model.source or model.name)
-    C = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
+    C = observation(disc, measured)
     n_free = len(disc.free)
     rigid = rigid_body_count(disc)
     n_model = n_model_modes or min(max(2 * measured.n_modes, measured.n_modes + 4) + rigid,

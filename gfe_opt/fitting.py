@@ -48,7 +48,7 @@ from .assembly import discretise
 from .correlation import mac, pair_by_frequency, pair_modes
 from .effects import EffectType, effect_type
 from .errors import GfeInputError, GfeSolverError
-from .measured import MeasuredModes, sensor_matrix
+from .measured import MeasuredModes, observation, sensor_matrix
 from .modal import discretisation_modes, rigid_body_count
 from .model import Effect, Model
 
@@ -143,8 +143,8 @@ def residuals(model, measured, noise: Noise, C=None):
         f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
         r[rows] = f_err / noise.freq
         return r, f_err, None
-    if C is None:
-        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    if C is None or disc.shear_g is not None:
+        C = observation(disc, measured)
     shapes = C @ modes.shapes
     mac_matrix = mac(measured.shapes, shapes)
     elastic = np.where(modes.frequencies_hz > 0, np.nan_to_num(mac_matrix), 0.0)

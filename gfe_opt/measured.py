@@ -545,11 +545,62 @@ def on_model(measured: MeasuredModes, model) -> tuple[MeasuredModes, list[str]]:
                   "the structure still: left out (it reads only noise)"]
 
 
-def sensor_matrix(nodes, kind: str, x, dof: str, source="measured") -> sp.csr_matrix:
+def _shear_sensor_matrix(n_el, L, e, xi, shear_g) -> sp.csr_matrix:
+    r"""Deflection at sensors of a Timoshenko beam: cubic Hermite in w with nodal slopes
+    :math:`w' = θ + γ`, θ the section rotation and γ the shear strain at the node.
+
+    Each element's shear strain is constant (the element of eq. 18 interpolates w and θ
+    interdependently): :math:`γ_e = \frac{g}{1+g}\left(\frac{w_j - w_i}{L} -
+    \frac{θ_i + θ_j}{2}\right)`.  It is superconvergent at the element's middle, so the
+    nodal γ is the cubic (Lagrange) interpolation of the four nearest elements' values
+    (fewer when the beam has fewer elements).  Exact at the nodes, exact for static end
+    loads, and O(h³) between them on vibration modes (the inertia inside an element;
+    ``tests/test_shear_sensors.py`` measures rates of 3.1-4.1 on closed-form modes: 3e-4 of
+    the amplitude in mode 5 of an L/h = 6 beam at 40 elements); at g = 0 it is plain
+    Hermite.  Taking θ as the slope does not converge at all at fixed κGA (off by 1.8 % in
+    that mode), the element's own interdependent functions (constant γ) are O(h²) (1 %).
+    """
+    n_nodes, n_dof = n_el + 1, 2 * (n_el + 1)
+    c = np.broadcast_to(np.asarray(shear_g, float), (n_el,))
+    c = c / (1.0 + c)
+    cols = 2 * np.arange(n_el)[:, None] + np.arange(4)
+    strain = sp.csr_matrix(((c[:, None] * np.array([-1.0 / L, -0.5, 1.0 / L, -0.5])).ravel(),
+                            (np.repeat(np.arange(n_el), 4), cols.ravel())),
+                           shape=(n_el, n_dof))
+    k = min(4, n_el)
+    rows, cols, vals = [], [], []
+    for i in range(n_nodes):
+        first = min(max(i - 2, 0), n_el - k)
+        mid = first + 0.5 + np.arange(k)
+        for a in range(k):
+            others = np.delete(mid, a)
+            rows.append(i)
+            cols.append(first + a)
+            vals.append(np.prod((i - others) / (mid[a] - others)))
+    nodal = sp.csr_matrix((vals, (rows, cols)), shape=(n_nodes, n_el)) @ strain
+    pick = np.arange(n_nodes)
+    w = sp.csr_matrix((np.ones(n_nodes), (pick, 2 * pick)), shape=(n_nodes, n_dof))
+    slope = sp.csr_matrix((np.ones(n_nodes), (pick, 2 * pick + 1)),
+                          shape=(n_nodes, n_dof)) + nodal
+    H = el.hermite(xi)
+    return (sp.diags(H[:, 0]) @ w[e] + sp.diags(L * H[:, 1]) @ slope[e]
+            + sp.diags(H[:, 2]) @ w[e + 1] + sp.diags(L * H[:, 3]) @ slope[e + 1]).tocsr()
+
+
+def observation(disc, measured) -> sp.csr_matrix:
+    """:func:`sensor_matrix` of a discretisation (its Timoshenko g, if any) and a test."""
+    return sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source,
+                         shear_g=getattr(disc, "shear_g", None))
+
+
+def sensor_matrix(nodes, kind: str, x, dof: str, source="measured",
+                  shear_g=None) -> sp.csr_matrix:
     """Observation matrix C (n_sensors, n_dof): model response at the sensors = C φ.
 
     A sensor between nodes is interpolated with the element shape functions (cubic Hermite
     for a beam's w, linear for a bar's u); a sensor outside the structure is an error.
+    With ``shear_g`` (Timoshenko g = 12EI/(κGAL²), per element or one value) the nodal θ of
+    a beam is the section rotation, not the slope: see :func:`_shear_sensor_matrix`.
     """
     nodes = np.asarray(nodes, float)
     length = nodes[-1] - nodes[0]
@@ -570,6 +621,8 @@ def sensor_matrix(nodes, kind: str, x, dof: str, source="measured") -> sp.csr_ma
     e = np.clip(np.floor((x - nodes[0]) / L).astype(int), 0, n_el - 1)
     xi = np.clip((x - nodes[e]) / L, 0.0, 1.0)
     if kind == "beam":
+        if shear_g is not None:
+            return _shear_sensor_matrix(n_el, L, e, xi, shear_g)
         vals = el.hermite(xi) * np.array([1.0, L, 1.0, L])
         cols = 2 * e[:, None] + np.arange(4)
         n_dof = 2 * (n_el + 1)

@@ -338,10 +338,10 @@ def vibrating_modes(disc: Discretisation, n_modes: int):
 def own_modes(disc: Discretisation, measured):
     """The vibrating modes of ``disc`` at the measured sensors, noise-free, as measured data
     (as many as were measured; a 0 Hz "measured" mode would be refused as bad input)."""
-    from .measured import make_measured, sensor_matrix
+    from .measured import make_measured, observation
 
     modes = vibrating_modes(disc, measured.n_modes)
-    C = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
+    C = observation(disc, measured)
     return make_measured(measured.x, measured.dof, modes.frequencies_hz, C @ modes.shapes,
                          measured.source)
 

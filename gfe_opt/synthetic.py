@@ -72,7 +72,7 @@ def synthetic_measurement(truth: Model, n_modes: int, sensors, *, shape_noise=0.
     disc = reference_discretisation(truth, n_ref)
     modes = discretisation_modes(disc, n_modes)
     dof = "w" if truth.kind == "beam" else "u"
-    C = sensor_matrix(disc.nodes, disc.kind, sensors, dof, "synthetic")
+    C = sensor_matrix(disc.nodes, disc.kind, sensors, dof, "synthetic", shear_g=disc.shear_g)
     shapes = C @ modes.shapes
     rng = np.random.default_rng(seed)
     shapes = shapes + shape_noise * np.max(np.abs(shapes), axis=0) * rng.standard_normal(

@@ -171,7 +171,7 @@ def timoshenko_ss(n_modes, EI, rho_a, rho_i, kga, length):
     a2 = rho_a * rho_i
     a1 = -(rho_a * (EI * alpha**2 + kga) + rho_i * kga * alpha**2)
     a0 = kga * alpha**2 * (EI * alpha**2 + kga) - (kga * alpha) ** 2
-    omega2 = (-a1 - np.sqrt(a1**2 - 4 * a2 * a0)) / (2 * a2)
+    omega2 = 2 * a0 / (-a1 + np.sqrt(a1**2 - 4 * a2 * a0))  # the lower root, no cancellation
     return np.sqrt(omega2) / (2 * np.pi)
 
 
