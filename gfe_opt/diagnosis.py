@@ -59,6 +59,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.special import chdtri
+from scipy.stats import norm
 
 from .correlation import check_model_size, check_units, compare
 from .effects import candidate_names, effect_type
@@ -89,10 +90,17 @@ __all__ = ["DEFAULT_FREQ_NOISE", "DEFAULT_SHAPE_NOISE", "Diagnosis", "UpdateOutc
 SIGNIFICANCE_LEVEL = 0.999
 #: a significant effect lies this many standard deviations from "no effect"
 SIZE_SIGMAS = 3.0
-#: residuals correlated more than this from sensor to sensor are model error, not noise
-WHITE_NOISE_CORRELATION = 0.3
-#: frequencies off by more than this many times the assumed noise are not noise
+#: two-sided normal quantile of the whiteness test of the shape residuals (α = 10⁻³)
+WHITE_NOISE_Z = float(norm.isf(0.5 * (1.0 - SIGNIFICANCE_LEVEL)))
+#: a frequency-only test with no noise given: frequencies off by more than this many times
+#: the assumed noise (0.05 %: 0.2 % rms) are not called noise.  An assumption, not derived:
+#: frequencies alone carry no test of their own noise (with shapes, the whiteness of the
+#: shape residuals decides and no such limit applies); give --freq-noise to judge at the
+#: test's own level
 FREQ_NOISE_LIMIT = 4.0
+#: a fit that raises the rms frequency error by more than this many (stated or assumed)
+#: standard deviations is never proposed, whatever it does to the shapes
+FREQ_RISE_SIGMAS = 2.0
 VERDICTS = ("consistent", "effect_found", "unexplained")
 #: a candidate must lower χ² by at least this much to be ranked at all (every significance
 #: threshold is far larger: χ²₁(1 − 10⁻³) = 10.8)
@@ -108,6 +116,21 @@ def fits_noise(m: Misfit, n_params: int, scale: float = 1.0) -> bool:
     """χ² within the 99.9 % range of ``scale`` × the stated noise."""
     dof = max(m.n_residuals - n_params, 1)
     return m.chi2 <= scale * quantile(dof, 1.0 - SIGNIFICANCE_LEVEL)
+
+
+def white(correlation: float, measured: MeasuredModes) -> bool:
+    """Shape residuals that look like noise: the correlation of neighbouring sensors'
+    residuals within what white noise gives (mean −1/n_s after each mode's mean is removed,
+    standard deviation 1/√(modes·(n_s − 1)) from the pairs), two-sided at α = 10⁻³.  Model
+    error is smooth along the structure and correlates neighbours.  A frequency-only test
+    has no shapes to test: white."""
+    if measured.frequency_only or not np.isfinite(correlation):
+        return True
+    n = measured.n_sensors
+    if n < 3:
+        return True
+    sd = 1.0 / np.sqrt(measured.n_modes * (n - 1))
+    return abs(correlation + 1.0 / n) < WHITE_NOISE_Z * sd
 
 
 def shape_correlation(model: Model, measured: MeasuredModes, noise: Noise, C=None) -> float:
@@ -176,6 +199,9 @@ class Diagnosis:
     generic_update: object = None                     # the UpdateResult they come from
     profile_band: object = None                       # ProfileBand of the generic update
     notes: list = field(default_factory=list)
+    #: after the suggested effects: None when they bring the misfit to the noise, else
+    #: {"chi2_per_residual", "freq_error_rms_pct", "where": [x, ...]} (``diagnose --json``)
+    remaining: dict | None = None
 
     @property
     def best(self) -> Fit | None:
@@ -204,6 +230,7 @@ class Diagnosis:
                                  "uncertainty": jsonable(s)}
                                 for e, s in zip(self.together.effects, self.together.sigma)],
                     **self.together.misfit.summary()},
+                "remaining": None if self.remaining is None else jsonable(self.remaining),
                 "realisation": list(self.realisation),
                 "notes": list(self.notes)}
 
@@ -223,32 +250,19 @@ def fitted_parameter_count(name: str) -> int:
 
 
 def check_enough_modes(measured: MeasuredModes, effects) -> None:
-    """Each effect needs at least as many measured modes as it has fitted parameters (one
-    mode cannot tell a crack's position from its depth); together they need five residuals
-    (frequencies and shape values) per parameter, or, frequencies alone, two frequencies per
-    parameter.  With fewer, a frequency-only fit has too little left to be judged by: on the
-    real cantilever of the README ten frequencies took material + section_loss (5
-    parameters) to 0.096 % and then a crack (7) to 0.026 %, each step "significant" at the
-    assumed noise."""
-    for e in effects:
-        need = fitted_parameter_count(e.name)
-        if measured.n_modes < need:
-            raise GfeInputError(measured.source, "modes", f"{e.name} needs at least {need} "
-                                f"measured modes, the file has {measured.n_modes}")
+    """A fit needs more measured values than fitted parameters (frequency-only: more
+    frequencies).  Whether the data *determine* the parameters is asked of each fit instead
+    (:attr:`~gfe_opt.fitting.Fit.unidentified`: σ above the value, or two parameters that
+    trade with a correlation above 0.99), not decided by a budget of values per parameter."""
     total = sum(fitted_parameter_count(e.name) for e in effects)
-    if measured.frequency_only:
-        if measured.n_modes < 2 * total:
-            names = " + ".join(e.name for e in effects)
-            raise GfeInputError(measured.source, "modes", f"{names} has {total} parameters: "
-                                f"{measured.n_modes} measured frequencies alone cannot judge "
-                                f"them ({2 * total} needed, two per parameter)")
-        return
-    residuals = measured.n_values
-    if residuals < 5 * total:
+    values = measured.n_modes if measured.frequency_only else measured.n_values
+    if values <= total:
         names = " + ".join(e.name for e in effects)
-        raise GfeInputError(measured.source, "modes", f"{names} has {total} parameters: the "
-                            f"{residuals} measured values (frequencies and shapes) cannot "
-                            "determine them (5 per parameter needed)")
+        what = "measured frequencies" if measured.frequency_only else (
+            "measured values (frequencies and shapes)")
+        raise GfeInputError(measured.source, "modes", f"{names} has {total} fitted "
+                            f"parameters: {values} {what} cannot determine them (more values "
+                            "than parameters needed)")
 
 
 def _candidates(model: Model, candidates) -> list[str]:
@@ -433,7 +447,7 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
         f.gain = sel.reference_chi2 - f.misfit.chi2
         f.threshold = sel.threshold(f)
         f.significant = (f.success and not f.failed and f.gain > f.threshold
-                         and f.size_sigmas >= SIZE_SIGMAS)
+                         and f.size_sigmas >= SIZE_SIGMAS and not f.unidentified)
         if f.significant and material is not None and f.name != material.name \
                 and not material.failed:
             f.significant = sel.better(f, material)
@@ -519,15 +533,16 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         """Brings the misfit to the noise: the stated one, or with no noise given, residuals
         that look like noise (uncorrelated from sensor to sensor, frequencies within a
         test's precision)."""
-        if fit.misfit.freq_error_rms_pct > ref_misfit.freq_error_rms_pct + 200 * noise.freq:
+        if (fit.misfit.freq_error_rms_pct
+                > ref_misfit.freq_error_rms_pct + 100 * FREQ_RISE_SIGMAS * noise.freq):
             return False  # never propose what raises the frequency error beyond the noise
         if fits_noise(fit.misfit, fit.n_params):
             return True
         if noise.given:
             return False
-        white = (measured.frequency_only or abs(shape_correlation(fit.model, measured, noise, C))
-                 < WHITE_NOISE_CORRELATION)
-        return white and fit.misfit.chi2_freq / max(fit.misfit.n_freq, 1) <= FREQ_NOISE_LIMIT**2
+        if measured.frequency_only:
+            return fit.misfit.chi2_freq / max(fit.misfit.n_freq, 1) <= FREQ_NOISE_LIMIT**2
+        return white(shape_correlation(fit.model, measured, noise, C), measured)
 
     partial = together = None
     suggested = []
@@ -554,10 +569,14 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                 notes.append(f"{best.name} explains part of the difference; the "
                              f"{profile.name} explains it to the noise")
                 best.significant = False
-            else:  # no finding: what explains less than the best does not explain either
+            elif profile is not None and profile.significant and sel.better(profile, best):
+                # a free profile explains significantly more than every named effect and
+                # pair: no named finding; how the structure differs is the profile
                 partial = best
                 for f in fits:
                     f.significant = False
+            # else: the best named effect is the finding, and what remains after it is said
+            # (``remaining``): the next diagnosis works on it
         if profile is not None and profile.significant and not explains(profile):
             if partial is None and (best is None or not best.significant):
                 partial = profile
@@ -566,8 +585,14 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             notes.append(f"{partial.name} explains part of the difference (χ²/n "
                          f"{ref_misfit.chi2_per_residual:.3g} -> "
                          f"{partial.misfit.chi2_per_residual:.3g}: {partial.describe()}), but "
-                         "neither it, nor it with one more effect, nor a free profile brings "
-                         "the misfit to the noise")
+                         "neither it nor it with one more effect brings the misfit to the "
+                         "noise" + ("" if profile is None or partial is profile else
+                                    f", and a free {profile.name} explains significantly "
+                                    f"more (χ²/n {profile.misfit.chi2_per_residual:.3g}: "
+                                    f"{profile.describe()})"))
+    notes += [f"{f.name} is not estimable from these data: " + "; ".join(f.unidentified)
+              for f in fits if not f.failed and f.unidentified and f.gain > f.threshold
+              and f.size_sigmas >= SIZE_SIGMAS]
     ranked = _rank([f for f in fits if not f.failed and f.significant], sel) + _rank(
         [f for f in fits if not f.failed and not f.significant], sel)
     failed = [f for f in fits if f.failed]
@@ -587,7 +612,32 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     estimate = _noise_estimate(model, measured, noise, [*ranked, reference, together], C,
                                ref_misfit,
                                sel.floor)
-    verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate)
+    verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate, measured)
+    if verdict == "effect_found" and suggested:
+        undecided = _undetermined(together, model)
+        if undecided:  # the pair is not determined: the first effect alone may still be
+            said = set(equivalent_notes(together, measured))
+            notes = [n for n in notes if n not in said and not n.endswith("add them together")]
+            notes.append(_undecided_note(together, undecided, measured, len(model.effects))
+                         .replace("nothing is suggested", "the pair is not suggested"))
+            suggested, together = [], None
+    if verdict == "effect_found" and not suggested:
+        undecided = _undetermined(ranked[0], model)
+        if undecided:  # parameters the data do not determine: not a finding
+            notes.append(_undecided_note(ranked[0], undecided, measured,
+                                         len(model.effects)))
+            for f in ranked:
+                f.significant = False
+            verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate, measured)
+    remaining = None
+    if verdict == "effect_found":
+        finding = together if suggested else ranked[0]
+        if not explains(finding):
+            where = compare(finding.model, measured,
+                            noise=max(noise.shape, 1e-3)).failure_places()
+            remaining = {"chi2_per_residual": finding.misfit.chi2_per_residual,
+                         "freq_error_rms_pct": finding.misfit.freq_error_rms_pct,
+                         "where": [x for x, _ in where]}
     words = (words or []) + _band_caution(words, estimate)
     if verdict == "effect_found" and not suggested:
         suggested = [ranked[0].name]
@@ -598,7 +648,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         notes.append(measured.without_shapes_note())
         if realise and model.kind == "beam":
             notes.append("the generic-element update needs mode shapes: not run")
-    notes += _noise_notes(estimate, verdict)
+    notes += _noise_notes(estimate, verdict, measured)
     if skipped:
         notes.append(_skipped_note(skipped, measured, model))
     return Diagnosis(baseline=baseline, reference=reference, fits=ranked, failed=failed,
@@ -608,22 +658,12 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                      seconds=time.perf_counter() - start, localisation=places,
                      realisation=_words_for_verdict(words or [], verdict),
                      nodal=nodal or [], generic_update=generic, profile_band=band,
-                     notes=notes)
+                     notes=notes, remaining=remaining)
 
 
 def _skipped_note(skipped, measured, model) -> str:
-    """One sentence for the candidates not tried; those stopped by the frequency budget
-    (two frequencies per parameter) are named together."""
-    budget = [n for n, r in skipped if "two per parameter" in r]
-    rest = [(n, r) for n, r in skipped if n not in budget]
-    parts = []
-    if budget:
-        held = sum(fitted_parameter_count(e.name) for e in model.effects)
-        parts.append(f"{', '.join(budget)} ({measured.n_modes} frequencies alone judge at "
-                     f"most {measured.n_modes // 2} parameters; the model's effects hold "
-                     f"{held})")
-    parts += [f"{n} ({r})" for n, r in rest]
-    return "not tried: " + "; ".join(parts)
+    """One sentence for the candidates not tried."""
+    return "not tried: " + "; ".join(f"{n} ({r})" for n, r in skipped)
 
 
 def _discretise(model):
@@ -728,6 +768,60 @@ def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
     return notes
 
 
+def _undetermined(fit, model) -> list:
+    """The effect sets that fit as well as ``fit`` and are not its mirror image on a
+    symmetric model (which symmetry explains): each is a reason the data do not determine
+    the finding."""
+    symmetric = model.supports[0] == model.supports[1] and not any(
+        effect_type(e.name).local for e in model.effects)
+    out = []
+    for effects in fit.equivalent:
+        if symmetric and _mirrored(fit.effects, effects, model.length):
+            continue
+        out.append(effects)
+    return out
+
+
+def _mirrored(effects, others, length) -> bool:
+    """Two effect lists equal up to x -> L - x (positions within 2 % of the length, other
+    numbers within 5 %)."""
+    if len(effects) != len(others):
+        return False
+    for a, b in zip(effects, others):
+        if a.name != b.name:
+            return False
+        for key, value in a.parameters.items():
+            other = b.parameters.get(key)
+            if isinstance(value, (list, tuple, str)) or other is None:
+                if value != other:
+                    return False
+            elif key == "position":
+                if abs(length - value - other) > 0.02 * length:
+                    return False
+            elif abs(value - other) > 0.05 * max(abs(value), abs(other), 1e-300):
+                return False
+    return True
+
+
+def _undecided_note(fit, undecided, measured, held) -> str:
+    """The finding (the fit's effects after the ``held`` ones of the model), its
+    alternatives and what measurement would decide."""
+    what = "the frequencies" if measured.frequency_only else "the data"
+    alternatives = "; or ".join(", ".join(
+        f"{e.name}: {effect_type(e.name).describe(e.parameters)}" for e in effects[held:])
+        for effects in undecided)
+    found = ", ".join(f"{e.name}: {effect_type(e.name).describe(e.parameters)}"
+                      for e in fit.effects[held:])
+    places = sorted({round(float(e.parameters["position"]), 3)
+                     for effects in [fit.effects, *undecided] for e in effects[held:]
+                     if isinstance(e.parameters.get("position"), (int, float))})
+    near = f" near x = {', '.join(f'{x:g}' for x in places)} m" if places else ""
+    decide = ("mode shapes (sensors" + near + ")" if measured.frequency_only
+              else "more modes, or sensors" + (near or " closer together"))
+    return (f"not a finding: {what} fit {found} as well as {alternatives}, so they do not "
+            f"determine it; nothing is suggested — {decide} would decide")
+
+
 def equivalent_notes(fit, measured) -> list[str]:
     """Sentences for other parameter sets that fit the data as well as ``fit``."""
     what = "the frequencies" if measured.frequency_only else "the data"
@@ -785,19 +879,18 @@ def _noise_estimate(model, measured, noise, fits, C, ref_misfit, floor) -> Noise
                          float(implied_shape), float(floor), correlation)
 
 
-def _verdict(ranked, ref_misfit, ref_params, noise, estimate) -> str:
+def _verdict(ranked, ref_misfit, ref_params, noise, estimate, measured) -> str:
     if ranked and ranked[0].significant:
         return "effect_found"
     if fits_noise(ref_misfit, ref_params):
         return "consistent"
-    white = estimate.implied_shape is None or abs(estimate.correlation) < WHITE_NOISE_CORRELATION
-    if (not noise.given and white
-            and estimate.implied_freq <= FREQ_NOISE_LIMIT * noise.freq):
+    if not noise.given and (white(estimate.correlation, measured) if not measured.frequency_only
+                            else estimate.implied_freq <= FREQ_NOISE_LIMIT * noise.freq):
         return "consistent"
     return "unexplained"
 
 
-def _noise_notes(est: NoiseEstimate, verdict: str) -> list[str]:
+def _noise_notes(est: NoiseEstimate, verdict: str, measured) -> list[str]:
     stated = "stated" if est.given else "assumed"
     ratio_f = est.implied_freq / est.freq
     if est.implied_shape is None:
@@ -813,7 +906,7 @@ def _noise_notes(est: NoiseEstimate, verdict: str) -> list[str]:
             f"{100 * est.freq:.2g} %)")
     notes = [line]
     if max(ratio_s, ratio_f) > 1.5:
-        if abs(est.correlation) >= WHITE_NOISE_CORRELATION:
+        if not white(est.correlation, measured):
             notes.append(f"the remaining shape residuals are correlated from sensor to sensor "
                          f"({est.correlation:.2f}): a difference of the structure, not noise")
         elif verdict == "consistent" and not est.given:
@@ -952,7 +1045,9 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
                              f"{fit.status})")
     return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit,
                          added=list(range(len(model.effects), len(fit.effects))),
-                         notes=[*dropped, *equivalent_notes(fit, measured)])
+                         notes=[*dropped, *equivalent_notes(fit, measured),
+                                *(["not estimable from these data: " + u
+                                   for u in fit.unidentified])])
 
 
 def _default_fixed(kind, model):

@@ -242,6 +242,7 @@ class Fit:
     notes: list = field(default_factory=list)
     mirror_position: float | None = None   # fits as well at x -> L - x (set by diagnosis)
     equivalent: list = field(default_factory=list)  # other effect sets that fit as well
+    unidentified: list = field(default_factory=list)  # parameters these data do not estimate
 
     @property
     def effect(self) -> str:
@@ -369,13 +370,14 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     effects = effects_of(z)
     fitted = base.with_effects(effects, check=False)
     fit_misfit = misfit(fitted, measured, noise, C)
-    sigma = _uncertainty(residual, z, slots, base, fit_misfit, lower, upper)
+    sigma, unidentified = _uncertainty(residual, z, slots, base, fit_misfit, lower, upper)
     added = [i for i, s in enumerate(slots) if s.added]
     return Fit(name=name or (slots[added[0]].effect.name if added else "baseline"),
                effects=tuple(effects), sigma=tuple(sigma), added=added[0] if added else None,
                model=fitted, misfit=fit_misfit, n_params=z.size, status=status,
                success=success and np.isfinite(fit_misfit.chi2), evaluations=counter["n"],
-               equivalent=[tuple(effects_of(e)) for e in equivalent])
+               equivalent=[tuple(effects_of(e)) for e in equivalent],
+               unidentified=unidentified)
 
 
 #: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
@@ -639,12 +641,20 @@ def _secant(S, s, J_old, J_new, r_new, g_old):
     return S + (np.outer(e, y) + np.outer(y, e)) / ys - float(e @ s) * np.outer(y, y) / ys**2
 
 
-def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper) -> list[dict]:
-    """Standard deviations of every slot's physical parameters (Gauss–Newton)."""
+#: a parameter is not estimable from the data when its σ exceeds its own size, or when
+#: its correlation with another fitted parameter exceeds this (they trade: only a
+#: combination is determined)
+IDENTIFIABLE_CORRELATION = 0.99
+
+
+def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper):
+    """Standard deviations of every slot's physical parameters (Gauss–Newton), and the
+    parameters the data do not estimate (sentences: σ above the value, or a correlation
+    above :data:`IDENTIFIABLE_CORRELATION` with another parameter)."""
     n = z.size
     out = [{} for _ in slots]
     if n == 0 or not np.isfinite(fit_misfit.chi2):
-        return out
+        return out, []
     r0 = residual(z)
     # second-order differences: forward ones (step 1e-6) gave σ that moved by 1e-3 between
     # two optima 1e-4 σ apart (a section loss on the demo), a printed digit at 99.95 σ
@@ -658,6 +668,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper) -> list[dic
         cov = np.full((n, n), np.inf)
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     sd = np.where(np.diag(A) > 1e-9 * max(float(np.max(np.diag(A))), 1e-300), sd, np.inf)
+    names, unidentified = [], []
     i = 0
     for j, slot in enumerate(slots):
         for v in slot.variables:
@@ -668,8 +679,24 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper) -> list[dic
                 out[j][v.key] = float(value)
             else:
                 out[j].setdefault(v.key, []).append(float(value))
+            label = (f"{slot.effect.name}.{v.key}" if v.index is None
+                     else f"{slot.effect.name}.{v.key}[{v.index}]")
+            names.append(label)
+            rule = slot.effect.parameter(v.key).rule if v.index is None else "ratios"
+            if slot.added and rule in ("positive", "fraction") and not value <= abs(phys):
+                unidentified.append(f"{label}: σ {value:.3g} exceeds its value {phys:.3g}")
             i += 1
-    return out
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sd, sd)
+    owner = [k for k, slot in enumerate(slots) for _ in slot.variables]
+    added = {i for i, k in enumerate(owner) if slots[k].added} or set(range(n))
+    for a in range(n):
+        for b in range(a + 1, n):
+            if (a in added or b in added) and np.isfinite(corr[a, b]) \
+                    and abs(corr[a, b]) > IDENTIFIABLE_CORRELATION:
+                unidentified.append(f"{names[a]} and {names[b]} trade against each other "
+                                    f"(correlation {corr[a, b]:+.3f})")
+    return out, unidentified
 
 
 def _with_null(effect: EffectType, v, base) -> tuple:

@@ -127,6 +127,14 @@ def format_diagnosis(result, model) -> str:
                          f"{pair.misfit.freq_error_rms_pct:.3f} %, χ²/n "
                          f"{_ratio(now.chi2_per_residual)} -> "
                          f"{_ratio(pair.misfit.chi2_per_residual)}")
+        remaining = getattr(result, "remaining", None)
+        if remaining is not None:
+            where = (" where: " + ", ".join(f"x = {x:.3f} m" for x in remaining["where"])
+                     if remaining["where"] else "")
+            lines.append(f"  a difference remains after it: χ²/n "
+                         f"{_ratio(remaining['chi2_per_residual'])}, frequency error "
+                         f"{remaining['freq_error_rms_pct']:.3f} %{where} — diagnose again "
+                         "after adding it")
         adds = " ".join(f"--add {name}" for name in result.suggested)
         them = "it" if len(result.suggested) == 1 else "them"
         lines.append(f"  add {them}: gfe-opt update MODEL MEASURED {adds}")

@@ -51,6 +51,24 @@ class ReferenceBeam:
     point_masses: list = field(default_factory=list)     # (x, kg)
     point_springs: list = field(default_factory=list)    # (x, N/m)
     end_springs: dict = field(default_factory=dict)      # "left"/"right" -> N m/rad
+    hinges: list = field(default_factory=list)           # (x, N m/rad): a rotational spring
+    #                                                      between the two sides of a node
+
+    def dof_map(self):
+        """Element DOFs (n, 4) and the number of DOFs: a hinge gives the element to the
+        right of its node (the nearest) its own rotation."""
+        n, h = self.elements, self.length / self.elements
+        dofs = 2 * np.arange(n)[:, None] + np.arange(4)[None, :]
+        size = 2 * (n + 1)
+        pairs = []
+        for x, k in self.hinges:
+            node = int(round(x / h))
+            if not 0 < node < n:
+                raise ValueError("a hinge must lie inside the beam")
+            dofs[node, 1] = size
+            pairs.append((2 * node + 1, size, k))
+            size += 1
+        return dofs, size, pairs
 
     def _gauss(self):
         n, h = self.elements, self.length / self.elements
@@ -67,10 +85,9 @@ class ReferenceBeam:
         ke += self.tension * np.einsum("q,qi,qj->ij", w, D1, D1)
         ke += self.foundation * np.einsum("q,qi,qj->ij", w, N, N)
         me = np.einsum("eq,q,qi,qj->eij", ra, w, N, N)
-        dofs = 2 * np.arange(n)[:, None] + np.arange(4)[None, :]
+        dofs, size, hinges = self.dof_map()
         rows = np.repeat(dofs, 4, axis=1).ravel()
         cols = np.tile(dofs, (1, 4)).ravel()
-        size = 2 * (n + 1)
         K = sp.coo_matrix((ke.ravel(), (rows, cols)), shape=(size, size)).tolil()
         M = sp.coo_matrix((me.ravel(), (rows, cols)), shape=(size, size)).tolil()
         for xp, value, target in ([(xp, m, M) for xp, m in self.point_masses]
@@ -82,8 +99,13 @@ class ReferenceBeam:
                 for b in range(4):
                     target[idx[a], idx[b]] += value * shape[a] * shape[b]
         for side, k in self.end_springs.items():
-            dof = 1 if side == "left" else size - 1
+            dof = 1 if side == "left" else 2 * n + 1
             K[dof, dof] += k
+        for a, b, k in hinges:
+            K[a, a] += k
+            K[b, b] += k
+            K[a, b] -= k
+            K[b, a] -= k
         fixed = []
         for node, support in ((0, self.supports[0]), (n, self.supports[1])):
             fixed += {"pinned": [2 * node], "clamped": [2 * node, 2 * node + 1],
@@ -105,7 +127,7 @@ class ReferenceBeam:
         # Gauss points (the assembled K loses eps N^4 of relative accuracy, this does not)
         n, h, s, w, x = self._gauss()
         _, _, D2 = _hermite(s, h)
-        dofs = 2 * np.arange(n)[:, None] + np.arange(4)[None, :]
+        dofs = self.dof_map()[0]
         curvature = np.einsum("qi,eim->eqm", D2, full[dofs])
         ei = self.EI * (self.rigidity(x) if self.rigidity else np.ones_like(x))
         bending = np.einsum("eq,q,eqm->m", ei, w, curvature**2)
@@ -122,7 +144,7 @@ class ReferenceBeam:
         sensors = np.asarray(sensors, float)
         e = np.minimum((sensors / h).astype(int), self.elements - 1)
         N = _hermite(sensors / h - e, h)[0]
-        dofs = 2 * e[:, None] + np.arange(4)[None, :]
+        dofs = self.dof_map()[0][e]
         shapes = np.einsum("si,sim->sm", N, full[dofs])
         return add_noise(freqs, shapes, shape_noise, freq_noise, seed)
 

@@ -123,11 +123,12 @@ def test_malformed_measured_files(good, tmp_path, capsys, name, text, match):
     (["update", "{model}", "{m}", "--add", "crack:depth_ratio=1.5,position=0.2"],
      "depth_ratio: must lie between 0 and 1"),
     (["modes", "{model}", "--out", "{tmp}/x.uff", "--modes", "0"], "--modes: must be >= 1"),
-    (["update", "{model}", "{m1}", "--add", "crack"], "crack needs at least 2 measured modes"),
+    (["update", "{model}", "{m1}", "--add", "crack"],
+     "1 measured frequencies cannot determine them"),
 ])
 def test_bad_options(good, tmp_path, capsys, args, match):
     tmp, data = good
-    one = dict(data, modes=data["modes"][:1])
+    one = {"modes": [{"frequency": data["modes"][0]["frequency"]}]}   # one frequency alone
     (tmp_path / "m1.json").write_text(json.dumps(one))
     names = {"model": tmp / "model.toml", "m": tmp / "m.json", "m1": tmp_path / "m1.json",
              "tmp": tmp_path}

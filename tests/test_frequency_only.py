@@ -79,13 +79,12 @@ def test_frequency_only_limits(tmp_path):
     with pytest.raises(GfeInputError, match="shapes"):
         update_generic(model, measured)
     check_enough_modes(measured, [Effect("material", {})])
-    # frequencies alone: two per fitted parameter (a crack has two: position and depth)
-    with pytest.raises(GfeInputError, match="4 needed, two per parameter"):
-        check_enough_modes(measured, [Effect("crack", {})])
+    check_enough_modes(measured, [Effect("crack", {})])   # whether it is determined: the fit
+    # frequencies alone: more frequencies than fitted parameters, whatever they are
+    with pytest.raises(GfeInputError, match="3 measured frequencies cannot determine them"):
+        check_enough_modes(measured, [Effect("crack", {}), Effect("material", {})])
     four = make_measured(None, "w", cantilever_frequencies(4), None, "four frequencies")
-    check_enough_modes(four, [Effect("crack", {})])
-    with pytest.raises(GfeInputError, match="6 needed"):
-        check_enough_modes(four, [Effect("crack", {}), Effect("material", {})])
+    check_enough_modes(four, [Effect("crack", {}), Effect("material", {})])
 
 
 @pytest.mark.parametrize("start", [0.2, 0.8])
@@ -106,9 +105,12 @@ def test_a_cracks_mirror_image_is_named_not_guessed(start):
 
 
 def test_frequency_only_cantilever_loop_ends_without_a_crack():
-    """Issue 11 target: ten frequencies of a cantilever whose clamp gives and which carries a
-    tip mass; the loop (diagnose, add what it suggests, again) never adds a crack, never
-    raises the error, and ends with the frequency error at the noise."""
+    """Ten frequencies of a cantilever whose clamp gives and which carries a tip mass: the
+    loop (diagnose, add what it suggests, again) never adds a crack and never raises the
+    error.  The soft clamp is found; with a tip mass the ten frequencies fit as well at
+    (2.0e4 N m/rad, 0.050 kg, the truth) as at (2.4e5 N m/rad, 0.62 kg): χ² 2.2 and 2.4 for
+    10 values.  The data do not determine the pair, and the tool says so (issue 21) and
+    names the measurement that decides instead of picking one."""
     noise = 0.0005
     f = cantilever_frequencies(10, noise)
     measured = make_measured(None, "w", f, None, "cantilever, frequencies only")
@@ -126,10 +128,14 @@ def test_frequency_only_cantilever_loop_ends_without_a_crack():
         added += d.suggested
     else:
         pytest.fail(f"no end after adding {added}")
-    assert d.verdict == "consistent", (d.verdict, added)
     assert "crack" not in added
     assert set(added) <= {"support_spring", "point_mass", "material", "support_translation"}
     assert np.all(np.diff(errors) <= 1e-9), errors
-    assert errors[-1] < 2 * 100 * noise, errors       # rms error within twice the noise [%]
     spring = [e for e in model.effects if e.name == "support_spring"]
     assert spring, added
+    if d.verdict != "consistent":   # the pair's two solutions named, and what decides
+        undecided = [n for n in d.notes if n.startswith("not a finding")]
+        assert undecided and "point_mass" in undecided[0], d.notes
+        assert "mode shapes" in undecided[0] and not d.suggested
+    else:
+        assert errors[-1] < 2 * 100 * noise, errors   # rms error within twice the noise [%]
