@@ -723,7 +723,8 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
     jobs = [("candidate", (model, measured, name, noise, hint, None, (first,),
                            [alone[name]] if name in alone else []))
             for name in seconds]
-    pairs = [p for p in _run_jobs(jobs, None, seconds) if p.success and explains(p)]
+    pairs = [p for p in _run_jobs(jobs, None, seconds)
+             if p.success and not p.unidentified and explains(p)]
     return _rank(pairs, sel)[0] if pairs else None
 
 

@@ -132,6 +132,7 @@ def run_case(case) -> dict:
         result = diagnose(model, measured, **noise)
         row["verdicts"].append(result.verdict)
         row["first_chi2_per_residual"] = result.baseline.chi2_per_residual
+        row["first_candidates"] = _candidates_of(result)
         fit = None
         for _ in range(ROUNDS):
             if result.verdict != "effect_found":
@@ -157,6 +158,63 @@ def run_case(case) -> dict:
     if row["exit"]:
         row.update(class_right=False, verdict_right=False, false_alarm=_no_local(case))
     return row
+
+
+def _candidates_of(result) -> list:
+    """What the sweep needs of the first diagnosis: per candidate its gain, the degrees of
+    freedom and the α it was tested at, its size in σ, χ² and parameter count."""
+    from scipy.special import chdtrc
+
+    floor = result.noise.floor
+    ref = result.reference.n_params if result.reference else 0
+    out = []
+    for f in result.fits:
+        p = max(f.n_params - ref, 1)
+        out.append({"name": f.name, "gain": f.gain, "p": p, "n_params": f.n_params,
+                    "alpha": float(chdtrc(p, f.threshold / floor)) if f.threshold else 1.0,
+                    "size_sigmas": f.size_sigmas, "usable": bool(f.success and not f.failed
+                                                                 and not f.unidentified),
+                    "chi2": f.misfit.chi2, "n": f.misfit.n_residuals, "floor": floor})
+    return out
+
+
+def sweep(rows, cases) -> list:
+    """First-diagnosis outcome under other significance levels and size thresholds,
+    recomputed from the stored candidates (no refit): % of cases whose first pick is right
+    (a right name when a detectable effect is hidden, nothing local otherwise) and false
+    alarms."""
+    from scipy.special import chdtri
+
+    from gfe_opt.effects import effect_type
+
+    by_name = {c.name: c for c in cases}
+    out = []
+    for level in (1e-2, 1e-3, 1e-4, 1e-5):
+        for size in (2.0, 3.0, 4.0, 5.0):
+            right = alarms = total = 0
+            for r in rows:
+                if "first_candidates" not in r:
+                    continue
+                case = by_name[r["name"]]
+                sig = [c for c in r["first_candidates"] if c["usable"]
+                       and c["size_sigmas"] >= size and c["gain"] > c["floor"] * chdtri(
+                           c["p"], min(c["alpha"] * level / 1e-3, 0.5))]
+                pick = min(sig, key=lambda c: c["chi2"] / c["floor"]
+                           + c["n_params"] * np.log(c["n"]))["name"] if sig else None
+                local = pick is not None and effect_type(pick).local
+                detectable = [h for h in case.hidden if h.klass != "none"
+                              and case.signal >= truths.DETECTABLE]
+                if detectable:
+                    ok = pick in set().union(*(truths.ANSWERS[h.klass] for h in detectable))
+                else:
+                    ok = not local
+                alarms += _no_local(case) and local
+                right += ok
+                total += 1
+            out.append({"alpha": level, "size_sigmas": size,
+                        "first_pick_right_pct": 100 * right / max(total, 1),
+                        "false_alarms": int(alarms), "cases": total})
+    return out
 
 
 def _no_local(case) -> bool:
@@ -270,6 +328,9 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=2100)
     parser.add_argument("--json", type=Path, help="also write the scorecard here")
     parser.add_argument("--cases", nargs="*", help="only cases whose name contains these")
+    parser.add_argument("--sweep", action="store_true",
+                        help="also print the first diagnosis under other significance "
+                        "levels and size thresholds (what chose α = 1e-3 and 3 σ)")
     args = parser.parse_args(argv)
     cases = truths.campaign(args.seed, args.subset)
     if args.cases:
@@ -280,14 +341,24 @@ def main(argv=None) -> int:
         rows.append(row)
         print(f"[{i}/{len(cases)}] {case.name}: {' -> '.join(row['verdicts']) or 'exit'} "
               f"added {row['added']} {'OK' if row['verdict_right'] else 'WRONG'} "
-              f"({row['seconds']:.1f} s){' ' + row['error'].splitlines()[-1] if row['error'] else ''}",
+              f"({row['seconds']:.1f} s)"
+              + (" " + row["error"].splitlines()[-1] if row["error"] else ""),
               file=sys.stderr, flush=True)
     card = scorecard(rows)
     doc = {"cases": rows, "scorecard": card}
+    if args.sweep:
+        doc["sweep"] = sweep(rows, cases)
     text = json.dumps(doc, indent=1, default=float)
     if args.json:
         args.json.write_text(text)
     print(table(card))
+    if args.sweep:
+        print("\nsweep of the first diagnosis (α: significance level before the look-"
+              "elsewhere division; size: σ from 'no effect'):")
+        print(f"{'alpha':>8}{'size σ':>8}{'first pick right':>18}{'false alarms':>14}")
+        for s in doc["sweep"]:
+            print(f"{s['alpha']:>8.0e}{s['size_sigmas']:>8.0f}"
+                  f"{s['first_pick_right_pct']:>17.1f}%{s['false_alarms']:>14}")
     return 0
 
 

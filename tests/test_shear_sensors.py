@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from gfe_opt.assembly import discretise
-from gfe_opt.model import Effect
 from gfe_opt.fitting import misfit, noise_of
 from gfe_opt.measured import make_measured, observation, sensor_matrix
+from gfe_opt.model import Effect
 
 from .conftest import make_model
 from .reference import add_noise, timoshenko_ss

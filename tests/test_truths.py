@@ -7,16 +7,15 @@ import pytest
 
 from .continuum import continuum_modes
 from .reference import ReferenceBeam, timoshenko_ss
-from .truths import (DETECTABLE, campaign, draw, line_spring_compliance, rizos_compliance,
-                     tada_f)
+from .truths import DETECTABLE, campaign, draw, line_spring_compliance, rizos_compliance, tada_f
 
 E, NU, RHO, B = 206e9, 0.3, 7800.0, 0.01
 
 
 def _closed_forms(L, h, n):
-    A, I = B * h, B * h**3 / 12
-    eb = np.arange(1, n + 1) ** 2 * np.pi / 2 / L**2 * np.sqrt(E * I / (RHO * A))
-    tim = timoshenko_ss(n, E * I, RHO * A, RHO * I, 5 / 6 * E / (2 * (1 + NU)) * A, L)
+    A, inertia = B * h, B * h**3 / 12
+    eb = np.arange(1, n + 1) ** 2 * np.pi / 2 / L**2 * np.sqrt(E * inertia / (RHO * A))
+    tim = timoshenko_ss(n, E * inertia, RHO * A, RHO * inertia, 5 / 6 * E / (2 * (1 + NU)) * A, L)
     return eb, tim
 
 

@@ -332,11 +332,11 @@ def _shear_case(rng, seed) -> Case:
     h = float(L / rng.uniform(5.0, 9.0))
     b = BEAM["b"]
     E, nu, rho = BEAM["E"], BEAM["nu"], BEAM["rho"]
-    A, I = b * h, b * h**3 / 12
+    A, inertia = b * h, b * h**3 / 12
     kga = 5 / 6 * E / (2 * (1 + nu)) * A
     n_modes = int(rng.integers(3, 7))
     x = np.sort(rng.uniform(0.02, 0.98, int(rng.integers(15, 46)))) * L
-    f = timoshenko_ss(n_modes, E * I, rho * A, rho * I, kga, L)
+    f = timoshenko_ss(n_modes, E * inertia, rho * A, rho * inertia, kga, L)
     y = np.sin(np.outer(x, np.arange(1, n_modes + 1) * np.pi / L))
     factor = float(rng.choice([1.0, 1.5, 2.0]))
     f, y = add_noise(f, y, factor * SHAPE_NOISE, factor * FREQ_NOISE, seed + 1)
