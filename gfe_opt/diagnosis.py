@@ -10,42 +10,36 @@ again; a local one (a crack, a point mass, ...) is proposed as a further instanc
 candidate tries its own starting points (a grid, where the model fails, each side of a
 support spring) and keeps the best.
 
-Significance (model selection that survives model error)
---------------------------------------------------------
-χ² is in units of the stated (or assumed) noise.  Discretisation error and unmodelled physics
-make it larger than the noise, and then any extra parameter "helps", so every test is made
-against the **noise floor** :math:`s^2 = \max(1, \min_f χ^2_f/(n - p_f))`, the residual
-variance of the most flexible fit reached.  A candidate adding p parameters is significant
-when
+Selection (one procedure; README "Diagnosis" states it with the same numbers)
+-----------------------------------------------------------------------------
+χ² is in units of the stated (or assumed) noise.
 
-1. it lowers χ² against the present effects re-estimated by more than
-   :math:`s^2\,χ^2_{p}(1-α')`, with α = 10⁻³ divided by the number of candidates and, for an
-   effect with a position, by the 2m + 1 places that m modes can tell apart (a scan over the
-   structure finds a good-looking place by chance: the look-elsewhere effect);
-2. its size is determined: it lies at least 3 standard deviations from "no effect" (a mass
-   on a pinned support, a spring of no effect never are);
-3. for effects other than ``material``: it explains more than the best uniform change of E
-   by the same margin (a uniform change is not called a crack).
-
-Candidates are ranked by the Bayesian information criterion χ²/s² + p ln n (the simpler
-effect wins unless the other fits better by ln n per extra parameter).
-
-Named effects first, profiles when nothing named suffices
----------------------------------------------------------
-When the best named effect does not bring χ² within the stated noise, the
-``stiffness_profile`` (EI piecewise linear on 2, 3, 5, 9 knots, started from the paper's
-generic-element update with the nodal parameterisation and fitted with the same misfit) is
-fitted too (and ``mass_profile`` when that is not enough).  If the profile is significantly
-better than the named effect, the named effect is kept only when it and one more effect (the
-next candidates, or a further instance of itself) explain the data as well as the profile;
-otherwise the profile is the finding.  Profiles count all their knots as parameters.
+1. Every candidate is fitted with the present effects re-estimated.
+2. Noise floor :math:`s^2 = \max(1, \min_f χ^2_f/(n - p_f))` over the fits reached: model
+   error makes every extra parameter "help", so every test is made against it.
+3. A candidate adding p parameters is **significant** when it lowers χ² by more than
+   :math:`s^2\,χ^2_{p}(1-α')`, α = 10⁻³ divided by the number of candidates and, for an
+   effect with a position, by the 2m + 1 places m modes can tell apart (look-elsewhere);
+   lies :data:`SIZE_SIGMAS` standard deviations from "no effect"; beats the best uniform
+   change of E by the same margin (effects other than ``material``); and is **estimable**:
+   no parameter with σ above its value, no two with a correlation above 0.99
+   (:attr:`~gfe_opt.fitting.Fit.unidentified`).
+4. Significant candidates are ranked by χ²/s² + p ln n (Bayesian information criterion).
+5. The best **explains** the data when χ² is within the 99.9 % range of the stated noise;
+   with no noise given, when the shape residuals are white (:func:`white`; frequency-only:
+   within :data:`FREQ_NOISE_LIMIT` of the assumed noise).
+6. If it does not: a pair that explains (estimable) is suggested; else a free profile that
+   explains is the finding; else, when the profile is significantly better than the best,
+   nothing named is a finding (``unexplained``); else the best is the finding and
+   ``remaining`` says what is left after it.
+7. A finding that another converged end fits as well (not its mirror image on a symmetric
+   beam) is not a finding: the data do not determine it (:func:`_undetermined`).
 
 Verdict
 -------
-``effect_found`` (the first entry is significant), ``consistent`` (nothing significant and
-χ² within the 99.9 % range of the stated noise; or, with no noise given, residuals that look
-like noise: uncorrelated from sensor to sensor), ``unexplained`` (nothing significant and the
-model does not fit to the noise).  The noise the data imply is always stated.
+``effect_found`` (a significant, determined finding), ``consistent`` (nothing significant and
+χ² within the 99.9 % range of the stated noise; or, with no noise given, white residuals),
+``unexplained`` (otherwise).  The noise the data imply is always stated.
 """
 
 from __future__ import annotations
@@ -283,7 +277,8 @@ def _candidates(model: Model, candidates) -> list[str]:
 # -------------------------------------------------------------------------------------------
 
 
-def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), seeds=()):
+def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), seeds=(),
+                   thorough=False):
     """Fit one candidate from each of its starting points, keep the best.  ``given`` holds
     parameters the user fixed as starting values; ``extra`` effects are added first
     (lookahead pairs); from frequencies alone IPOPT then runs from every start, ``seeds``
@@ -300,7 +295,8 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
     for starts in groups.values():
         fit = fit_effects(model, measured, [*extra, Effect(name, starts[0])], noise=noise,
                           name=name, alternatives=starts[1:],
-                          multistart=True if extra and measured.frequency_only else "auto")
+                          multistart=True if (extra or thorough) and measured.frequency_only
+                          else "auto")
         if best is None or _preferred(fit, best):
             best = fit
     if extra:
@@ -612,7 +608,9 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     estimate = _noise_estimate(model, measured, noise, [*ranked, reference, together], C,
                                ref_misfit,
                                sel.floor)
-    verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate, measured)
+    current = (float("nan") if measured.frequency_only or noise.given else
+               shape_correlation(reference.model if reference else model, measured, noise, C))
+    verdict = _verdict(ranked, ref_misfit, ref_params, noise, current, measured)
     if verdict == "effect_found" and suggested:
         undecided = _undetermined(together, model)
         if undecided:  # the pair is not determined: the first effect alone may still be
@@ -621,6 +619,15 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             notes.append(_undecided_note(together, undecided, measured, len(model.effects))
                          .replace("nothing is suggested", "the pair is not suggested"))
             suggested, together = [], None
+    if verdict == "effect_found" and not suggested and measured.frequency_only \
+            and not ranked[0].equivalent and ranked[0].added is not None:
+        # frequencies alone: the finding's fit again from every start (as a pair's is), so
+        # an equally good end elsewhere is found before the finding is declared
+        again = _fit_candidate(model, measured, ranked[0].name, noise, hint, thorough=True)
+        if again.success:
+            ends = [again.effects, *again.equivalent]
+            ranked[0].equivalent = [e for e in ends
+                                    if _other_end(e, again.misfit.chi2, ranked[0], sel)]
     if verdict == "effect_found" and not suggested:
         undecided = _undetermined(ranked[0], model)
         if undecided:  # parameters the data do not determine: not a finding
@@ -628,7 +635,9 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                                          len(model.effects)))
             for f in ranked:
                 f.significant = False
-            verdict = _verdict(ranked, ref_misfit, ref_params, noise, estimate, measured)
+            current = (float("nan") if measured.frequency_only or noise.given else
+               shape_correlation(reference.model if reference else model, measured, noise, C))
+    verdict = _verdict(ranked, ref_misfit, ref_params, noise, current, measured)
     remaining = None
     if verdict == "effect_found":
         finding = together if suggested else ranked[0]
@@ -769,6 +778,20 @@ def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
     return notes
 
 
+def _other_end(effects, chi2, other, sel) -> bool:
+    """``effects`` (an end of a fit with χ² about ``chi2``) fit as well as ``other`` (χ²
+    within :data:`ALIKE_CHI2` floors) but elsewhere (a parameter more than 5 % apart)."""
+    if abs(chi2 - other.misfit.chi2) >= ALIKE_CHI2 * sel.floor:
+        return False
+    for a, b in zip(effects, other.effects):
+        for key, value in a.parameters.items():
+            v = b.parameters.get(key)
+            if isinstance(value, (int, float)) and isinstance(v, (int, float)) and abs(
+                    value - v) > 0.05 * max(abs(value), abs(v), 1e-300):
+                return True
+    return False
+
+
 def _undetermined(fit, model) -> list:
     """The effect sets that fit as well as ``fit`` and are not its mirror image on a
     symmetric model (which symmetry explains): each is a reason the data do not determine
@@ -880,13 +903,17 @@ def _noise_estimate(model, measured, noise, fits, C, ref_misfit, floor) -> Noise
                          float(implied_shape), float(floor), correlation)
 
 
-def _verdict(ranked, ref_misfit, ref_params, noise, estimate, measured) -> str:
+def _verdict(ranked, ref_misfit, ref_params, noise, current_correlation, measured) -> str:
+    """With no noise given, the model as it stands agrees when its own residuals look like
+    noise (white shapes; frequency-only: within :data:`FREQ_NOISE_LIMIT` of the assumed
+    noise), not when some better fit's do."""
     if ranked and ranked[0].significant:
         return "effect_found"
     if fits_noise(ref_misfit, ref_params):
         return "consistent"
-    if not noise.given and (white(estimate.correlation, measured) if not measured.frequency_only
-                            else estimate.implied_freq <= FREQ_NOISE_LIMIT * noise.freq):
+    if not noise.given and (
+            ref_misfit.chi2_freq / max(ref_misfit.n_freq, 1) <= FREQ_NOISE_LIMIT**2
+            if measured.frequency_only else white(current_correlation, measured)):
         return "consistent"
     return "unexplained"
 

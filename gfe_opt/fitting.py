@@ -268,7 +268,8 @@ class Fit:
                "uncertainty": jsonable(self.uncertainty), **self.misfit.summary(),
                "significant": self.significant, "mirror_position": self.mirror_position,
                "equivalent": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
-                               for e in effects] for effects in self.equivalent]}
+                               for e in effects] for effects in self.equivalent],
+               "not_estimable": list(self.unidentified)}
         return out
 
 
