@@ -37,8 +37,8 @@ sys.path.insert(0, str(ROOT))
 
 from gfe_opt.batch import read_table, run_batch  # noqa: E402
 from gfe_opt.model import load_model  # noqa: E402
-from gfe_opt.synthetic import write_campaign  # noqa: E402
 from gfe_opt.trend import trend  # noqa: E402
+from tests.truths import write_campaign  # noqa: E402
 
 ADD = ["material", "crack"]
 TRIM_THRESHOLD = 128 * 2**20

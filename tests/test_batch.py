@@ -1,6 +1,6 @@
 """Monitoring campaigns: ``gfe-opt batch`` (local pool, Dask, resume) and ``gfe-opt trend``.
 
-The campaign is made by :func:`gfe_opt.synthetic.write_campaign`: each set's truth is built
+The campaign is made by :func:`tests.truths.write_campaign`: each set's truth is built
 on a fine independent mesh (a Christides–Barr crack integrated with Hermite curvatures, not
 the exact-flexibility element that is updated), E moving ±1 % with a daily cycle, a crack
 appearing after a fifth of the sets and growing to a/d = 0.5.
@@ -24,9 +24,10 @@ from gfe_opt.cli import main
 from gfe_opt.fitting import misfit, noise_of
 from gfe_opt.measured import load_measured
 from gfe_opt.model import load_model, model_from_dict
-from gfe_opt.synthetic import write_campaign
 from gfe_opt.trend import trend
 from tests.conftest import STEEL_BEAM
+
+from .truths import write_campaign
 
 SMALL = {**STEEL_BEAM, "elements": 20}
 ADD = ["material", "crack"]
@@ -66,7 +67,10 @@ def test_rows_hold_every_fitted_parameter_and_the_crack_appears(campaign):
         measured = load_measured(tmp / "sets" / r["file"])
         before = misfit(model, measured, noise_of()).chi2_per_residual
         assert r["chi2_per_residual"] < before, (r["file"], r["chi2_per_residual"], before)
-        assert r["solver_status"] == "Solve_Succeeded", r
+        # IPOPT converges wherever the crack is there; before its onset the crack sits at
+        # its null, its position is undetermined and IPOPT may run out of iterations (the
+        # finish settles it): then it must not look like a crack
+        assert r["solver_status"] == "Solve_Succeeded" or r["crack.size_sigmas"] < 3, r
     t = trend(rows)
     truth_depth = np.array([d for d, _ in truths])
     first_crack = int(np.argmax(truth_depth > 0))

@@ -422,3 +422,57 @@ def campaign(seed: int = 2100, subset: int | None = None) -> list[Case]:
             cases.append(continuum_case(s) if klass == "continuum" else
                          draw(klass, s, pair_with=pair, frequency_only=freq_only))
     return cases[::subset] if subset else cases
+
+
+# -------------------------------------------------------------------------------------------
+# Monitoring campaigns (the batch tests and scripts/bench_batch.py)
+# -------------------------------------------------------------------------------------------
+
+
+def campaign_truth(i: int, n_sets: int, *, onset=0.2, final_depth=0.5, swing=0.01,
+                   sets_per_day=24) -> tuple[float, float]:
+    """The truth of set ``i`` of a monitoring campaign: (crack depth a/d, E factor).  No
+    crack for the first ``onset`` of the sets, then a/d growing linearly to
+    ``final_depth`` at the last set; E moving ±``swing`` with a daily temperature cycle."""
+    start = int(round(onset * n_sets))
+    depth = 0.0 if i < start else final_depth * (i - start + 1) / max(n_sets - start, 1)
+    factor = 1.0 + swing * np.sin(2 * np.pi * i / sets_per_day)
+    return float(depth), float(factor)
+
+
+def write_campaign(model, folder, n_sets: int, *, position=0.19, n_modes=5, sensors=None,
+                   shape_noise=0.003, freq_noise=0.0005, seed=0, reference_elements=400,
+                   **truth_options) -> list:
+    """Measured JSON files ``set-0001.json`` ... of a campaign on ``model`` (a gfe_opt
+    Model: its length, section, material and supports; hourly ``time`` stamps from
+    2026-01-01, ``label`` with the day and hour): each set's truth (:func:`campaign_truth`)
+    is the tests' own Hermite beam (:class:`~tests.reference.ReferenceBeam`) with the crack's
+    EI(x) and E scaled, not the package's model; returns the truths."""
+    import json
+    from datetime import datetime, timedelta
+    from pathlib import Path
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    L = model.length
+    sensors = np.linspace(0.0, L, 17)[1:-1] if sensors is None else np.asarray(sensors)
+    start = datetime(2026, 1, 1)
+    out = []
+    for i in range(n_sets):
+        depth, factor = campaign_truth(i, n_sets, **truth_options)
+        crack = christides_barr(position, depth, depth=model.depth) if depth > 0 else None
+        beam = ReferenceBeam(length=L, EI=model.E * model.inertia,
+                             rho_a=model.rho * model.area, supports=model.supports,
+                             elements=reference_elements,
+                             rigidity=product([crack, lambda x, f=factor: f + 0 * x]))
+        f, y = beam.measure(n_modes, sensors, shape_noise=shape_noise, freq_noise=freq_noise,
+                            seed=seed + i)
+        when = start + timedelta(hours=i)
+        data = {"time": when.isoformat(timespec="minutes"),
+                "label": f"day {i // 24 + 1} {when:%H}:00",
+                "sensors": {"x": [float(v) for v in sensors], "dof": "w"},
+                "modes": [{"frequency": float(f[j]), "shape": [float(v) for v in y[:, j]]}
+                          for j in range(n_modes)]}
+        (folder / f"set-{i + 1:04d}.json").write_text(json.dumps(data))
+        out.append((depth, factor))
+    return out
