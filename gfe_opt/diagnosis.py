@@ -196,6 +196,9 @@ class Diagnosis:
     #: after the suggested effects: None when they bring the misfit to the noise, else
     #: {"chi2_per_residual", "freq_error_rms_pct", "where": [x, ...]} (``diagnose --json``)
     remaining: dict | None = None
+    #: ``unexplained`` because a free profile explains significantly more than every named
+    #: effect and pair: its name (the note gives the ``update --add`` argument)
+    offered: list = field(default_factory=list)
 
     @property
     def best(self) -> Fit | None:
@@ -225,6 +228,7 @@ class Diagnosis:
                                 for e, s in zip(self.together.effects, self.together.sigma)],
                     **self.together.misfit.summary()},
                 "remaining": None if self.remaining is None else jsonable(self.remaining),
+                "offered": list(self.offered),
                 "realisation": list(self.realisation),
                 "notes": list(self.notes)}
 
@@ -541,7 +545,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         return white(shape_correlation(fit.model, measured, noise, C), measured)
 
     partial = together = None
-    suggested = []
+    suggested, offered = [], []
     if best is not None and not explains(best) or best is None and not fits_noise(
             ref_misfit, ref_params):
         profile = (_fallback(model, measured, noise, fallback_names, sel, band, progress)
@@ -553,6 +557,9 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             fits.append(profile)
         if best is not None and not explains(best):
             pair = _lookahead(model, measured, noise, best, fits, hint, explains, sel)
+            if pair is not None and profile is not None and profile.success \
+                    and not profile.failed and sel.better(profile, pair):
+                pair = None   # a free profile explains significantly more than the pair
             if pair is not None:
                 notes.append(f"{best.name} with a further {pair.name} brings the misfit to the "
                              f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}; frequency error "
@@ -585,7 +592,9 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                          "noise" + ("" if profile is None or partial is profile else
                                     f", and a free {profile.name} explains significantly "
                                     f"more (χ²/n {profile.misfit.chi2_per_residual:.3g}: "
-                                    f"{profile.describe()})"))
+                                    f"{profile.describe()}; to model it: gfe-opt update "
+                                    f"MODEL MEASURED --add {_profile_argument(profile)})"))
+            offered = [] if profile is None or partial is profile else [profile.name]
     notes += [f"{f.name} is not estimable from these data: " + "; ".join(f.unidentified)
               for f in fits if not f.failed and f.unidentified and f.gain > f.threshold
               and f.size_sigmas >= SIZE_SIGMAS]
@@ -667,7 +676,14 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                      seconds=time.perf_counter() - start, localisation=places,
                      realisation=_words_for_verdict(words or [], verdict),
                      nodal=nodal or [], generic_update=generic, profile_band=band,
-                     notes=notes, remaining=remaining)
+                     notes=notes, remaining=remaining,
+                     offered=offered if verdict == "unexplained" else [])
+
+
+def _profile_argument(profile) -> str:
+    """``stiffness_profile:x=0;0.2875;0.575`` for ``update --add`` (knots of the fit)."""
+    x = profile.parameters.get("x", [])
+    return f"{profile.name}:x=" + ";".join(f"{v:.6g}" for v in x)
 
 
 def _skipped_note(skipped, measured, model) -> str:
