@@ -556,15 +556,15 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             best = _best(fits, sel)
             fits.append(profile)
         if best is not None and not explains(best):
-            pair = _lookahead(model, measured, noise, best, fits, hint, explains, sel)
+            first, pair = _lookahead(model, measured, noise, best, fits, hint, explains, sel)
             if pair is not None and profile is not None and profile.success \
                     and not profile.failed and sel.better(profile, pair):
                 pair = None   # a free profile explains significantly more than the pair
             if pair is not None:
-                notes.append(f"{best.name} with a further {pair.name} brings the misfit to the "
+                notes.append(f"{first.name} with a further {pair.name} brings the misfit to the "
                              f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}; frequency error "
                              f"{pair.misfit.freq_error_rms_pct:.3g} %): add them together")
-                suggested, together = [best.name, pair.name], pair
+                suggested, together = [first.name, pair.name], pair
                 notes += equivalent_notes(pair, measured)
                 if profile is not None:
                     profile.significant = False  # named effects win where they explain
@@ -600,6 +600,11 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
               and f.size_sigmas >= SIZE_SIGMAS]
     ranked = _rank([f for f in fits if not f.failed and f.significant], sel) + _rank(
         [f for f in fits if not f.failed and not f.significant], sel)
+    if together is not None and ranked[0].name != suggested[0]:
+        # the pair's first effect leads: it is what the pair determines (a crack with a
+        # further crack, where a section loss alone fitted a hair better)
+        lead = next(f for f in ranked if f.name == suggested[0])
+        ranked = [lead] + [f for f in ranked if f is not lead]
     failed = [f for f in fits if f.failed]
     if realise and generic is not None:
         from .realisation import describe_profile, explain
@@ -736,8 +741,24 @@ def _fallback(model, measured, noise, names, sel, band, progress):
 
 def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
     """``best`` with one more effect: every other candidate that fitted, and a further
-    instance of ``best`` when it is local.  Returns the simplest pair that ``explains`` the data (χ²
-    plus the pair's parameter count as a tie-break), else None."""
+    instance of ``best`` when it is local.  Returns the simplest pair that ``explains`` the
+    data (by the information criterion), else None.  When no pair with ``best`` does, the
+    other significant candidates that ``best`` does not beat significantly are tried first
+    in turn (a short section loss and a crack fit one crack alike; with two cracks only the
+    pair of cracks is determined)."""
+    firsts = [best] + [f for f in _rank([f for f in fits if f.significant and not f.failed],
+                                        sel)
+                       if f is not best and not sel.better(best, f)
+                       and not getattr(effect_type(f.name), "fallback", False)]
+    for first_fit in firsts:
+        pair = _pairs_with(model, measured, noise, first_fit, fits, hint, explains, sel)
+        if pair is not None:
+            return first_fit, pair
+    return best, None
+
+
+def _pairs_with(model, measured, noise, best, fits, hint, explains, sel):
+    """The best pair of ``best`` and one more effect that ``explains`` the data, or None."""
     # a candidate whose own fit did not converge is still tried as the second effect
     others = [f for f in (fits[i] for i in ranked([f.misfit.chi2 for f in fits]))
               if f is not best and (not f.failed or not f.success) and f.name != best.name
