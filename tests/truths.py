@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .reference import STEEL, ReferenceBeam, add_noise, christides_barr, timoshenko_ss
+from .reference import STEEL, ReferenceBeam, add_noise, christides_barr, product, timoshenko_ss
 
 #: the stated noise of the issue: 0.05 % on frequencies, 0.3 % of each mode's largest value
 FREQ_NOISE, SHAPE_NOISE = 0.0005, 0.003
@@ -120,19 +120,6 @@ def smooth_zone(centre, length, ratio, edge):
         inside = 0.5 * (np.tanh((x - centre + length / 2) / (edge / 4))
                         - np.tanh((x - centre - length / 2) / (edge / 4)))
         return 1.0 + (ratio - 1.0) * inside
-    return f
-
-
-def product(fns):
-    fns = [f for f in fns if f is not None]
-    if not fns:
-        return None
-
-    def f(x):
-        out = np.ones_like(x)
-        for g in fns:
-            out = out * g(x)
-        return out
     return f
 
 
@@ -253,7 +240,7 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
         hidden.append(hid)
         for key, value in ch.items():
             if key in ("rigidity", "mass"):
-                changes[key] = product([changes.get(key), value])
+                changes[key] = product(*(f for f in (changes.get(key), value) if f is not None))
             elif key in ("hinges", "point_masses", "point_springs"):
                 changes[key] = changes.get(key, []) + value
             elif key == "end_springs":
@@ -464,7 +451,7 @@ def write_campaign(model, folder, n_sets: int, *, position=0.19, n_modes=5, sens
         beam = ReferenceBeam(length=L, EI=model.E * model.inertia,
                              rho_a=model.rho * model.area, supports=model.supports,
                              elements=reference_elements,
-                             rigidity=product([crack, lambda x, f=factor: f + 0 * x]))
+                             rigidity=product(crack, lambda x, f=factor: f + 0 * x))
         f, y = beam.measure(n_modes, sensors, shape_noise=shape_noise, freq_noise=freq_noise,
                             seed=seed + i)
         when = start + timedelta(hours=i)
