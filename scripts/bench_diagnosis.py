@@ -104,7 +104,7 @@ def _sigma_errors(hidden, effect, sigma, model):
     elif hidden.klass == "tension":
         truth = {"tension": hidden.size["tension"]}
     elif hidden.klass == "material":
-        truth = {"E": hidden.size["E_ratio"] * model.youngs_modulus}
+        truth = {"E": hidden.size["E_ratio"] * model.E}   # the model's own E, not its fit
     elif hidden.klass == "shear":
         truth = {"shear_rigidity": hidden.size["shear_rigidity"]}
     elif hidden.klass == "crack" and effect.name == "crack":
@@ -275,15 +275,18 @@ def _score(row, case, model, fit, added=None):
                                            and final in OUT_OF_FAMILY_VERDICTS)
     if case.signal < truths.DETECTABLE and not added:
         right = True   # the data cannot show it: "consistent" with nothing added is right
-    if rescoring:
-        z = row.get("z", [])
+    if rescoring and not all("uncertainty" in e for e in row.get("final_effects", [])):
+        z = row.get("z", [])   # rows stored without the σ of their fit
     row.update(class_right=right, verdict_right=right and verdict_ok,
                false_alarm=_no_local(case) and bool(extra_local),
                position_error_pct=positions, size_error_pct=sizes, z=z,
                extra=extra_local + extra_global, final_effects=[
                    {"effect": e.name, "parameters": {k: v for k, v in e.parameters.items()
-                                                     if not isinstance(v, list)}}
-                   for e in added])
+                                                     if not isinstance(v, list)},
+                    "uncertainty": {k: v for k, v in (sigmas[i] if i < len(sigmas)
+                                                      else {}).items()
+                                    if not isinstance(v, list)}}
+                   for i, e in enumerate(added)])
 
 
 def scorecard(rows) -> dict:
@@ -308,10 +311,57 @@ def scorecard(rows) -> dict:
                 "z_le_2_pct": 100 * float(np.mean(np.array(z) <= 2)) if z else None,
                 "z_le_2_in_family_pct": 100 * float(np.mean(np.array(fam) <= 2))
                 if fam else None,
+                "z_median": float(np.median(z)) if z else None,
                 "exit_2": sum(r["exit"] == 2 for r in rs),
                 "internal_errors": sum(r["exit"] == 1 for r in rs),
                 "seconds_per_case": float(np.mean([r["seconds"] for r in rs]))}
     return {name: summary(rs) for name, rs in sorted(groups.items())}
+
+
+def targets(rows) -> list:
+    """The issue's targets, each with what this run measured and whether it is met."""
+    card = scorecard(rows)
+    local_rows = [r for r in rows if r.get("position_error_pct")]
+    pos = [p for r in local_rows for p in r["position_error_pct"]]
+    quiet = [r for r in rows if r["group"] in ("none", "material")]
+    quiet_stated = [r for r in quiet if r["noise_factor"] == 1.0]
+    notch = [r for r in rows if r["name"].startswith("continuum-notch")]
+    deep = [r for r in rows if r["group"] == "shear"]
+    fam = [v for r in rows if r["in_family"] for v in r.get("z", [])]
+    cont = [v for r in rows if r["group"] == "continuum" for v in r.get("z", [])]
+    classes = {k: v for k, v in card.items() if k != "all"}
+    worst = min(classes.items(), key=lambda kv: kv[1]["verdict_right_pct"])
+
+    def pct(xs):
+        return 100 * float(np.mean(xs)) if len(xs) else None
+    out = [
+        ("internal errors, exit 2 on valid input", card["all"]["internal_errors"]
+         + card["all"]["exit_2"], "0", card["all"]["internal_errors"]
+         + card["all"]["exit_2"] == 0),
+        ("verdict right, all cases (%)", card["all"]["verdict_right_pct"], ">= 90",
+         card["all"]["verdict_right_pct"] >= 90),
+        (f"verdict right, worst class ({worst[0]}, %)", worst[1]["verdict_right_pct"],
+         ">= 80", worst[1]["verdict_right_pct"] >= 80),
+        ("continuum notches ending with a crack-like effect within 2 % (%)",
+         pct([r["class_right"] for r in notch]), "100",
+         all(r["class_right"] for r in notch)),
+        ("false alarms, no change or uniform E (% of cases)",
+         pct([r["false_alarm"] for r in quiet]), "<= 2",
+         (pct([r["false_alarm"] for r in quiet]) or 0) <= 2),
+        ("  of them at the stated noise (%)", pct([r["false_alarm"] for r in quiet_stated]),
+         "<= 2", (pct([r["false_alarm"] for r in quiet_stated]) or 0) <= 2),
+        ("local effects found within 2 % (% of those matched)",
+         pct([p <= 100 * POSITION_TOLERANCE for p in pos]), ">= 90",
+         (pct([p <= 100 * POSITION_TOLERANCE for p in pos]) or 0) >= 90),
+        ("deep beams ending with shear and consistent (%)",
+         pct([r["verdict_right"] for r in deep]), "100",
+         all(r["verdict_right"] for r in deep)),
+        ("in-family |error|/σ <= 2 (% of parameters)",
+         pct(np.array(fam) <= 2), ">= 90", (pct(np.array(fam) <= 2) or 0) >= 90),
+        ("continuum median |error|/σ (σ ignores model error)",
+         float(np.median(cont)) if cont else None, "report", True),
+    ]
+    return [{"target": t, "measured": m, "goal": g, "met": bool(ok)} for t, m, g, ok in out]
 
 
 def table(card) -> str:
@@ -348,9 +398,11 @@ def _rescore(args, cases) -> int:
         model = model_from_dict(case.model, case.name)
         added = [SimpleNamespace(name=e["effect"], parameters=e["parameters"])
                  for e in row["final_effects"]]
-        _score(row, case, model, None, added=added)
+        fit = SimpleNamespace(sigma=[e.get("uncertainty", {}) for e in row["final_effects"]])
+        _score(row, case, model, fit, added=added)
     card = scorecard(rows)
     doc["scorecard"] = card
+    doc["targets"] = targets(rows)
     if args.sweep:
         doc["sweep"] = sweep(rows, [by_name[r["name"]] for r in rows])
     if args.json:
@@ -361,6 +413,11 @@ def _rescore(args, cases) -> int:
 
 def _print(doc, with_sweep) -> None:
     print(table(doc["scorecard"]))
+    print("\nthe issue's targets:")
+    for t in doc["targets"]:
+        m = "-" if t["measured"] is None else f"{t['measured']:.3g}"
+        print(f"  {t['target']:<66}{m:>7}  goal {t['goal']:<6} "
+              f"{'met' if t['met'] else 'NOT MET'}")
     if with_sweep:
         print("\nsweep of the first diagnosis (α: significance level before the look-"
               "elsewhere division; size: σ from 'no effect'):")
@@ -397,7 +454,7 @@ def main(argv=None) -> int:
               + (" " + row["error"].splitlines()[-1] if row["error"] else ""),
               file=sys.stderr, flush=True)
     card = scorecard(rows)
-    doc = {"cases": rows, "scorecard": card}
+    doc = {"cases": rows, "scorecard": card, "targets": targets(rows)}
     if args.sweep:
         doc["sweep"] = sweep(rows, cases)
     text = json.dumps(doc, indent=1, default=float)
