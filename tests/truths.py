@@ -451,7 +451,8 @@ def write_campaign(model, folder, n_sets: int, *, position=0.19, n_modes=5, sens
         beam = ReferenceBeam(length=L, EI=model.E * model.inertia,
                              rho_a=model.rho * model.area, supports=model.supports,
                              elements=reference_elements,
-                             rigidity=product(crack, lambda x, f=factor: f + 0 * x))
+                             rigidity=product(*(g for g in (crack, lambda x, f=factor: f + 0 * x)
+                                                  if g is not None)))
         f, y = beam.measure(n_modes, sensors, shape_noise=shape_noise, freq_noise=freq_noise,
                             seed=seed + i)
         when = start + timedelta(hours=i)
