@@ -319,7 +319,7 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
     check_input_file(Path(model_path), "model")
     model = load_model(model_path)  # a bad model is one error, not a row per set
     if add:
-        from .diagnosis import parse_effect
+        from .model import parse_effect
 
         for text in add:
             parse_effect(text, model)

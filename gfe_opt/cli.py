@@ -10,28 +10,26 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import math
 import os
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from .correlation import DEFAULT_MAC_THRESHOLD, DEFAULT_SHAPE_NOISE, compare
-from .effects import EFFECTS
 from .errors import GfeInputError, GfeSolverError
-from .fitting import DEFAULT_FREQ_NOISE
-from .fitting import DEFAULT_SHAPE_NOISE as DEFAULT_FIT_SHAPE_NOISE
-from .identify import FRF_FORMS
-from .measured import load_measured
-from .model import load_model
-from .outputs import check_distinct, check_output_folder, check_output_path
-from .text import (
-    format_comparison,
-    format_diagnosis,
-    format_identification,
-    format_update,
-    terminal_progress,
+from .names import BUILTIN_EFFECTS as EFFECTS
+from .names import (
+    COMPARE_FIGURES,
+    DEFAULT_FIT_SHAPE_NOISE,
+    DEFAULT_FREQ_NOISE,
+    DEFAULT_MAC_THRESHOLD,
+    DIAGNOSIS_FIGURES,
+    FRF_FORMS,
 )
+from .names import DEFAULT_COMPARE_SHAPE_NOISE as DEFAULT_SHAPE_NOISE
+from .outputs import check_distinct, check_output_folder, check_output_path
+
+# numerical modules are imported by the commands that use them: --version, --help and
+# usage errors load no numerical library (CasADi, cvxpy, matplotlib: not even on bad input)
 
 
 def _fraction(text: str) -> float:
@@ -228,8 +226,6 @@ def _figures(build, *args) -> dict:
         raise GfeInputError("--plot/--report", None, str(exc)) from None
 
 
-from .report import COMPARE_FIGURES, DIAGNOSIS_FIGURES  # noqa: E402
-
 
 def _comparison_report(report, result, model, measured):
     report.heading("Comparison")
@@ -247,10 +243,21 @@ def _comparison_report(report, result, model, measured):
                          f"({100 * rel:.0f} % of the largest residual force).")
 
 
-def cmd_compare(args) -> int:
-    _check_outputs(args, COMPARE_FIGURES)
+def _inputs(args):
+    """The model and measured files of a command (input errors before any solver loads)."""
+    from .measured import load_measured
+    from .model import load_model
+
     model = load_model(args.model)
-    measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
+    return model, load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
+
+
+def cmd_compare(args) -> int:
+    from .correlation import compare
+    from .text import format_comparison
+
+    _check_outputs(args, COMPARE_FIGURES)
+    model, measured = _inputs(args)
     result = compare(model, measured, mac_threshold=args.mac_threshold, noise=args.shape_noise)
     if args.json:
         print(json.dumps(result.to_json(), indent=1))
@@ -268,9 +275,12 @@ def cmd_compare(args) -> int:
 
 
 def cmd_modes(args) -> int:
+    import numpy as np
+
     from .assembly import discretise
     from .measured import make_measured, save_measured
     from .modal import discretisation_modes, rigid_body_count
+    from .model import load_model
 
     check_output_path(args.out, args.force, (args.model,), kind="modes")
     model = load_model(args.model)
@@ -304,16 +314,16 @@ def cmd_modes(args) -> int:
 
 
 def cmd_diagnose(args) -> int:
-    from .diagnosis import diagnose
-
-    model = load_model(args.model)
-    measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
+    model, measured = _inputs(args)
     candidates = None
     if args.candidates is not None:
         candidates = [c.strip() for c in args.candidates.split(",") if c.strip()]
         if not candidates:
             raise GfeInputError("--candidates", None, "no effect named")
     _check_outputs(args, DIAGNOSIS_FIGURES)
+    from .diagnosis import diagnose
+    from .text import format_diagnosis, terminal_progress
+
     result = diagnose(model, measured, candidates=candidates, freq_noise=args.freq_noise,
                       shape_noise=args.shape_noise, progress=terminal_progress(not args.json),
                       realise=True)
@@ -336,15 +346,16 @@ def cmd_diagnose(args) -> int:
 
 
 def cmd_update(args) -> int:
-    from .diagnosis import parse_effect, update
-    from .model import save_model
+    model, measured = _inputs(args)
+    from .model import parse_effect, save_model
 
-    model = load_model(args.model)
-    measured = load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
     effects = [parse_effect(a, model) for a in args.add]
     if args.out is not None:  # refuse before the work, not after
         check_output_path(args.out, args.force, (args.model, args.measured), kind="model")
     _check_outputs(args, ("error.png",))
+    from .diagnosis import update
+    from .text import format_update
+
     outcome = update(model, measured, effects, freq_noise=args.freq_noise,
                      shape_noise=args.shape_noise)
     if args.out is not None:
@@ -378,7 +389,7 @@ def _band(text):
         band = (float(low), float(high))
     except ValueError:
         raise GfeInputError("--band", text, "must be LOW:HIGH in Hz, e.g. 10:1000") from None
-    if not sep or not all(np.isfinite(band)) or not 0 <= band[0] < band[1]:
+    if not sep or not all(map(math.isfinite, band)) or not 0 <= band[0] < band[1]:
         raise GfeInputError("--band", text, "must be LOW:HIGH in Hz with 0 <= LOW < HIGH")
     return band
 
@@ -386,6 +397,7 @@ def _band(text):
 def cmd_identify(args) -> int:
     from .identify import identify, load_frfs
     from .measured import save_measured
+    from .text import format_identification
 
     band = _band(args.band)
     if args.modes is not None and args.modes < 1:
@@ -476,6 +488,8 @@ def main(argv=None) -> int:
         except SystemExit as exc:  # usage errors (2) and --help (0) from argparse
             return int(exc.code or 0)
         args.argv = argv
+        import numpy as np
+
         with np.errstate(all="ignore"):
             from .outputs import replacing
 

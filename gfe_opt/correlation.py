@@ -36,9 +36,8 @@ from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, observation, on_model
 from .modal import Modes, discretisation_modes, rigid_body_count
 from .model import Model
-
-DEFAULT_MAC_THRESHOLD = 0.6
-DEFAULT_SHAPE_NOISE = 0.01
+from .names import DEFAULT_COMPARE_SHAPE_NOISE as DEFAULT_SHAPE_NOISE
+from .names import DEFAULT_MAC_THRESHOLD
 
 
 def mac(a, b) -> np.ndarray:

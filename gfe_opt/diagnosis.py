@@ -76,7 +76,7 @@ from .fitting import (
     slots_for,
 )
 from .measured import MeasuredModes, on_model, sensor_matrix
-from .model import Effect, Model, check_repeats, validate_effect
+from .model import Effect, Model, check_repeats, parse_effect
 
 __all__ = ["DEFAULT_FREQ_NOISE", "DEFAULT_SHAPE_NOISE", "Diagnosis", "UpdateOutcome",
            "diagnose", "parse_effect", "update"]
@@ -1024,42 +1024,6 @@ class UpdateOutcome:
                 "effects": [{"effect": e.name, "parameters": jsonable(e.parameters),
                              "uncertainty": jsonable(s)}
                             for e, s in zip(self.fit.effects, self.fit.sigma)]}
-
-
-def parse_effect(text: str, model: Model, where: str = "--add") -> Effect:
-    """``crack`` or ``crack:position=0.2,depth_ratio=0.4`` -> Effect.  Every value given is
-    checked against its allowed range (partial sets are starting values); a repeated or
-    unknown key is an error.  Lists (profiles) separate values by ``;``."""
-    name, _, rest = text.partition(":")
-    kind = effect_type(name.strip(), where, None)
-    params = {}
-    for item in rest.split(",") if rest.strip() else []:
-        key, eq, value = (part.strip() for part in item.partition("="))
-        if not eq or not value:
-            raise GfeInputError(where, text, f"expected key=value, got {item!r}")
-        if key not in kind.keys:
-            from .effects.base import no_unknown
-
-            try:
-                no_unknown({key: None}, set(kind.keys), where, "")
-            except GfeInputError as exc:
-                raise GfeInputError(where, text, f"{key}: {exc.problem} ({name} takes "
-                                    f"{', '.join(kind.keys)})") from None
-        if key in params:
-            raise GfeInputError(where, text, f"{key} is given twice")
-        rule = kind.parameter(key).rule
-        if rule == "choice":
-            params[key] = value
-        else:
-            try:
-                numbers = [float(v) for v in value.split(";")]
-            except ValueError:
-                raise GfeInputError(where, text, f"{key} must be a number, got {value!r}"
-                                    ) from None
-            params[key] = numbers if rule in ("knots", "ratios") else (
-                numbers[0] if len(numbers) == 1 else value)
-    params = validate_effect(model, kind.name, params, f"{where} {text}", "", partial=True)
-    return Effect(kind.name, params)
 
 
 def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,

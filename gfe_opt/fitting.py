@@ -44,6 +44,7 @@ import casadi as ca
 import numpy as np
 from scipy.special import chdtri
 
+from . import names
 from .assembly import discretise
 from .correlation import mac, pair_by_frequency, pair_modes
 from .effects import EffectType, effect_type
@@ -52,8 +53,8 @@ from .measured import MeasuredModes, observation, sensor_matrix
 from .modal import discretisation_modes, rigid_body_count
 from .model import Effect, Model
 
-DEFAULT_FREQ_NOISE = 0.0005
-DEFAULT_SHAPE_NOISE = 0.003
+DEFAULT_FREQ_NOISE = names.DEFAULT_FREQ_NOISE
+DEFAULT_SHAPE_NOISE = names.DEFAULT_FIT_SHAPE_NOISE
 #: cost of a residual when the model cannot be solved (e.g. buckled by a compression)
 FAILED_RESIDUAL = 1e6
 

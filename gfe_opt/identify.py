@@ -37,10 +37,10 @@ import numpy as np
 from .errors import GfeInputError, GfeSolverError
 from .inputs import check_input_file, read_text
 from .measured import MeasuredModes, make_measured
+from .names import FRF_FORMS  # noqa: F401 (part of this module's interface)
 
 #: ordinate data types of UFF dataset 58 (displacement, velocity, acceleration responses)
 UFF_FRF_FORMS = {8: "receptance", 11: "mobility", 12: "accelerance"}
-FRF_FORMS = ("accelerance", "mobility", "receptance")
 STABLE_FREQUENCY = 0.001
 STABLE_DAMPING = 0.05
 CLUSTER_WIDTH = 0.005

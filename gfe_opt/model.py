@@ -288,6 +288,42 @@ def validate_effect(model: Model, name: str, params: dict, where: str, prefix: s
                                                                  partial)
 
 
+def parse_effect(text: str, model: Model, where: str = "--add") -> Effect:
+    """``crack`` or ``crack:position=0.2,depth_ratio=0.4`` -> Effect.  Every value given is
+    checked against its allowed range (partial sets are starting values); a repeated or
+    unknown key is an error.  Lists (profiles) separate values by ``;``."""
+    from .effects import effect_type
+
+    name, _, rest = text.partition(":")
+    kind = effect_type(name.strip(), where, None)
+    params = {}
+    for item in rest.split(",") if rest.strip() else []:
+        key, eq, value = (part.strip() for part in item.partition("="))
+        if not eq or not value:
+            raise GfeInputError(where, text, f"expected key=value, got {item!r}")
+        if key not in kind.keys:
+            try:
+                no_unknown({key: None}, set(kind.keys), where, "")
+            except GfeInputError as exc:
+                raise GfeInputError(where, text, f"{key}: {exc.problem} ({name} takes "
+                                    f"{', '.join(kind.keys)})") from None
+        if key in params:
+            raise GfeInputError(where, text, f"{key} is given twice")
+        rule = kind.parameter(key).rule
+        if rule == "choice":
+            params[key] = value
+        else:
+            try:
+                numbers = [float(v) for v in value.split(";")]
+            except ValueError:
+                raise GfeInputError(where, text, f"{key} must be a number, got {value!r}"
+                                    ) from None
+            params[key] = numbers if rule in ("knots", "ratios") else (
+                numbers[0] if len(numbers) == 1 else value)
+    params = validate_effect(model, kind.name, params, f"{where} {text}", "", partial=True)
+    return Effect(kind.name, params)
+
+
 def check_repeats(effects, where: str, prefix: str = "effects") -> None:
     """A global effect (``material``, ``shear``, ...) may appear once; local ones repeat."""
     from .effects import effect_type

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from . import plots
 from .effects import effect_type
+from .names import COMPARE_FIGURES, DIAGNOSIS_FIGURES  # noqa: F401 (the figures a command may write)
 from .outputs import atomic_write
 
 
@@ -77,11 +78,6 @@ def update_figures(outcome) -> dict:
                                               (f"after ({names})",
                                                outcome.after.freq_error_rms_pct)])}
 
-
-#: the figures a command may write (checked before any work)
-COMPARE_FIGURES = ("mac.png", "frequencies.png", "localisation.png")
-DIAGNOSIS_FIGURES = ("candidates.png", "stiffness_change.png", "disturbance.png",
-                     "nodal_equations.png")
 
 
 def save_figures(figs: dict, folder) -> list[Path]:

@@ -161,3 +161,36 @@ def test_bad_add_exits_2(files, capsys, add, match):
     assert main(["update", str(model), str(measured), "--add", add]) == 2
     err = capsys.readouterr().err
     assert match in err and err.count("\n") == 1
+
+
+HEAVY = ("casadi", "cvxpy", "matplotlib")
+
+
+@pytest.mark.parametrize("argv", [["--version"], ["--help"], ["diagnose", "--help"],
+                                  ["compare"], ["diagnose", "missing.toml", "missing.json"],
+                                  ["update", "MODEL", "MEASURED", "--add", "rust"]])
+def test_startup_and_input_errors_load_no_solver_nor_plotting(files, argv):
+    """Issue 22: --version, --help and input errors import neither CasADi, cvxpy nor
+    matplotlib (each run in a fresh interpreter, which then lists what it imported)."""
+    model, measured, _ = files
+    argv = [str(model) if a == "MODEL" else str(measured) if a == "MEASURED" else a
+            for a in argv]
+    code = ("import sys; from gfe_opt.entry import main; sys.argv[1:] = %r; rc = main(); "
+            "print('loaded', sorted(m for m in %r if m in sys.modules), rc)") % (argv, HEAVY)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert "Traceback" not in out.stderr and out.returncode == 0
+    last = out.stdout.strip().splitlines()[-1]
+    assert last.startswith("loaded [] "), last
+    if "--help" in argv or "--version" in argv:
+        assert last.endswith(" 0") and len(out.stdout.splitlines()) > 1
+    else:   # usage errors print their usage line first
+        assert last.endswith(" 2") and out.stderr.strip().splitlines()[-1].startswith(
+            "gfe-opt")
+
+
+def test_builtin_effect_names_are_the_registered_ones():
+    from gfe_opt.effects import EFFECTS
+    from gfe_opt.names import BUILTIN_EFFECTS
+
+    assert BUILTIN_EFFECTS == tuple(EFFECTS)
