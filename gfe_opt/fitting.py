@@ -37,6 +37,7 @@ parameter the data cannot determine (a mass on a pinned support) gets an infinit
 
 from __future__ import annotations
 
+import os
 from collections import Counter
 from dataclasses import dataclass, field
 
@@ -130,12 +131,44 @@ def residuals(model, measured, noise: Noise, C=None):
     relative frequency errors and MACs of the pairs (None for a frequency-only test, whose
     modes pair by frequency and whose residuals are the frequencies alone); ``(None, ...)``
     if the solve fails."""
+    point = evaluate(model, measured, noise, C)
+    if point is None:
+        return None, np.zeros(0), np.zeros(0)
+    return point.r, point.f_err, point.macs
+
+
+@dataclass
+class Point:
+    """One evaluation of the residual, with what its derivative needs: the discretisation,
+    its matrices and modes, the pairs (measured ``rows``, model ``cols``), the observation
+    matrix and the normalisation of the paired shapes at the sensors."""
+
+    r: np.ndarray
+    f_err: np.ndarray
+    macs: np.ndarray | None
+    disc: object
+    K: object
+    M: object
+    modes: object
+    rows: np.ndarray
+    cols: np.ndarray
+    C: object = None
+    shat: np.ndarray | None = None      # unit shapes at the sensors (n_sensors, pairs)
+    norm: np.ndarray | None = None      # their norms before normalising
+    sign: np.ndarray | None = None      # the sign that aligns them with the measured ones
+    scale: np.ndarray | None = None     # σ_s max|y| of each pair
+
+
+def evaluate(model, measured, noise: Noise, C=None) -> Point | None:
+    """The residual of :func:`residuals` at ``model`` with its intermediate results; None
+    if the solve fails."""
     try:
         disc = discretise(model)
         n_model = min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(model))
-        modes = discretisation_modes(disc, n_model)
+        K, M = disc.global_matrices()
+        modes = discretisation_modes(disc, n_model, matrices=(K, M))
     except (GfeSolverError, ValueError, np.linalg.LinAlgError):
-        return None, np.zeros(0), np.zeros(0)
+        return None
     if measured.frequency_only:
         pairs = pair_by_frequency(measured.frequencies_hz, modes.frequencies_hz)
         rows = np.array([t for t, _ in pairs], dtype=int)
@@ -143,7 +176,7 @@ def residuals(model, measured, noise: Noise, C=None):
         r = np.full(measured.n_modes, 0.5 / noise.freq)
         f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
         r[rows] = f_err / noise.freq
-        return r, f_err, None
+        return Point(r, f_err, None, disc, K, M, modes, rows, cols)
     if C is None or disc.shear_g is not None:
         C = observation(disc, measured)
     shapes = C @ modes.shapes
@@ -156,11 +189,81 @@ def residuals(model, measured, noise: Noise, C=None):
     r[:, 0] = 0.5 / noise.freq  # an unpaired mode
     f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
     y = measured.shapes[:, rows] / np.linalg.norm(measured.shapes[:, rows], axis=0)
-    s = shapes[:, cols] / np.linalg.norm(shapes[:, cols], axis=0)
-    s = s * np.sign(np.sum(s * y, axis=0))
+    norm = np.linalg.norm(shapes[:, cols], axis=0)
+    shat = shapes[:, cols] / norm
+    sign = np.sign(np.sum(shat * y, axis=0))
+    scale = noise.shape * np.max(np.abs(y), axis=0)
     r[rows, 0] = f_err / noise.freq
-    r[rows, 1:] = ((s - y) / (noise.shape * np.max(np.abs(y), axis=0))).T
-    return r.ravel(), f_err, mac_matrix[rows, cols]
+    r[rows, 1:] = ((shat * sign - y) / scale).T
+    return Point(r.ravel(), f_err, mac_matrix[rows, cols], disc, K, M, modes, rows, cols,
+                 C, shat, norm, sign, scale)
+
+
+def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upper,
+                   step: float = 1e-5) -> np.ndarray:
+    """The Jacobian of the residual at ``point`` (the evaluation at z) with respect to z,
+    the pairing held: eigenvalue and eigenvector derivatives
+    (:func:`~gfe_opt.sensitivity.eigen_derivatives`) with ∂K, ∂M (and, for a shear beam,
+    the observation's ∂C) from second-order differences of the *matrices* of
+    ``model_at(z)`` (central; at a bound one-sided three-point, stepping inwards), no
+    modal solve besides the one of ``point``.  Raises ``ValueError`` where the modes have no
+    derivative (a repeated or zero eigenvalue among the paired ones)."""
+    from .sensitivity import eigen_derivatives
+
+    n = z.size
+    shear = point.disc.shear_g is not None and not measured.frequency_only
+
+    def matrices(zz):
+        disc = discretise(model_at(zz))
+        K, M = disc.global_matrices()
+        return K, M, (observation(disc, measured) if shear else None)
+
+    dK, dM, dC = [], [], []
+    for k in range(n):
+        h = step * max(1.0, abs(z[k]))
+        up, down = z.copy(), z.copy()
+        if z[k] + h <= upper[k] and z[k] - h >= lower[k]:
+            up[k] += h
+            down[k] -= h
+            a, b = matrices(up), matrices(down)
+            diff = [(x - y) / (2 * h) if x is not None else None for x, y in zip(a, b)]
+        else:
+            h = h if z[k] + 2 * h <= upper[k] else -h
+            up[k] += h
+            down[k] += 2 * h
+            here = (point.K, point.M, point.C if shear else None)
+            a, b = matrices(up), matrices(down)
+            diff = [(4 * x - y - 3 * c) / (2 * h) if x is not None else None
+                    for x, y, c in zip(a, b, here)]
+        dK.append(diff[0])
+        dM.append(diff[1])
+        dC.append(diff[2])
+    lam_all = (2 * np.pi * point.modes.frequencies_hz) ** 2
+    cols, rows = point.cols, point.rows
+    lam = lam_all[cols]
+    if np.any(lam <= 0):
+        raise ValueError("a paired mode has zero frequency: no derivative")
+    phi = point.modes.shapes[:, cols]
+    dlam, dphi = eigen_derivatives(point.K, point.M, point.disc.free, lam, phi, dK, dM,
+                                   all_lam=lam_all)
+    f_model = point.modes.frequencies_hz[cols]
+    dfreq = dlam / (2 * lam[:, None]) * (f_model / measured.frequencies_hz[rows])[:, None] \
+        / noise.freq
+    if measured.frequency_only:
+        J = np.zeros((measured.n_modes, n))
+        J[rows] = dfreq
+        return J
+    J = np.zeros((measured.n_modes, 1 + measured.n_sensors, n))
+    J[rows, 0] = dfreq
+    C = point.C
+    for i, t in enumerate(rows):
+        raw = C @ dphi[:, i, :]                                   # (sensors, n)
+        if shear:
+            raw = raw + np.column_stack([dC[k] @ phi[:, i] for k in range(n)])
+        s = point.shat[:, i]
+        ds = point.sign[i] * (raw - np.outer(s, s @ raw)) / point.norm[i]
+        J[t, 1:] = ds / point.scale[i]
+    return J.reshape(-1, n)
 
 
 def _max_modes(model: Model) -> int:
@@ -287,9 +390,103 @@ def jsonable(params: dict) -> dict:
     return {k: one(v) for k, v in params.items()}
 
 
+#: how fits differentiate the residual: "analytic" (eigen-derivatives) or "difference" (of
+#: the modal solves: the old path, kept for scripts/bench.py --parts fits, which sets it for
+#: every process through the environment variable GFE_OPT_JACOBIAN)
+JACOBIAN = os.environ.get("GFE_OPT_JACOBIAN", "analytic")
+if JACOBIAN not in ("analytic", "difference"):
+    raise GfeInputError("GFE_OPT_JACOBIAN", None, f"must be 'analytic' or 'difference', got "
+                        f"{JACOBIAN!r}")
+#: errors of a trial model that make its residual the failed one
+_TRIAL_ERRORS = (GfeInputError, GfeSolverError, ValueError, FloatingPointError,
+                 np.linalg.LinAlgError)
+
+
+class Objective:
+    """The residual r(z) of a fit, counted, the last evaluation kept (the Jacobian at a
+    point reuses its modal solve); ``jacobian(z, r, lower, upper)`` is the analytic one
+    (:func:`point_jacobian`, falling back to differences of r where the modes have no
+    derivative), None when fits difference the residual itself."""
+
+    def __init__(self, model_at, measured, noise, C, analytic: bool = True):
+        self.model_at, self.measured, self.noise, self.C = model_at, measured, noise, C
+        self.count = 0
+        self.fallbacks = 0
+        self._last = None
+        self.jacobian = self._analytic if analytic else None
+
+    def point(self, z) -> Point | None:
+        z = np.asarray(z, dtype=float)
+        key = z.tobytes()
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
+        self.count += 1
+        try:
+            point = evaluate(self.model_at(z), self.measured, self.noise, self.C)
+        except _TRIAL_ERRORS:
+            point = None
+        self._last = (key, point)
+        return point
+
+    def __call__(self, z) -> np.ndarray:
+        point = self.point(z)
+        return np.full(self.measured.n_values, FAILED_RESIDUAL) if point is None else point.r
+
+    def _analytic(self, z, r, lower, upper) -> np.ndarray:
+        point = self.point(z)
+        if point is not None:
+            try:
+                return point_jacobian(point, np.asarray(z, dtype=float), self.model_at,
+                                      self.measured, self.noise, lower, upper)
+            except _TRIAL_ERRORS:
+                pass
+        self.fallbacks += 1
+        return _difference_jacobian(self, z, r, lower, upper)
+
+
+@dataclass
+class FitProblem:
+    """What a fit works on: the model without effects, the slots, their variables' bounds,
+    the residual (:class:`Objective`) and the map from variables to effects."""
+
+    base: Model
+    slots: list
+    lower: np.ndarray
+    upper: np.ndarray
+    residual: Objective
+
+    def effects_of(self, z) -> list:
+        out, i = [], 0
+        for slot in self.slots:
+            k = len(slot.variables)
+            if k == 0:
+                out.append(Effect(slot.effect.name, slot.start))
+            else:
+                out.append(Effect(slot.effect.name, slot.effect.to_physical(
+                    self.base, slot.variables, z[i:i + k], slot.fixed)))
+            i += k
+        return out
+
+
+def fit_problem(model: Model, measured: MeasuredModes, adding=(), *, noise: Noise, C=None,
+                jacobian: str | None = None) -> FitProblem:
+    """The :class:`FitProblem` of :func:`fit_effects` (same arguments)."""
+    base = model.with_effects([], check=False)
+    slots = slots_for(model, adding)
+    if C is None:
+        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    lower = np.array([v.lower for s in slots for v in s.variables])
+    upper = np.array([v.upper for s in slots for v in s.variables])
+    problem = FitProblem(base, slots, lower, upper, None)
+    problem.residual = Objective(
+        lambda z: base.with_effects(problem.effects_of(z), check=False), measured, noise, C,
+        (jacobian or JACOBIAN) == "analytic")
+    return problem
+
+
 def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Noise,
                 max_iter: int = 25, C=None, name: str | None = None,
-                alternatives=(), multistart="auto") -> Fit:
+                alternatives=(), multistart="auto", jacobian: str | None = None) -> Fit:
     """Fit the parameters of the model's effects and of ``adding`` (effects whose given
     parameters are starting values; ``Effect(name, {})``: a grid chooses them).
     ``alternatives`` are further starting parameter sets of the last added effect (same
@@ -298,40 +495,18 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     the valleys are wide enough) or always (``True``), IPOPT runs
     again from profile starts (:func:`_profile_starts`: effects that trade against each
     other, a soft clamp and a tip mass) and, with ``True``, from every alternative; the
-    best end is kept, and ends that fit as well elsewhere are the fit's ``equivalent``."""
-    base = model.with_effects([], check=False)
-    slots = slots_for(model, adding)
-    if C is None:
-        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    best end is kept, and ends that fit as well elsewhere are the fit's ``equivalent``.
+    ``jacobian``: ``"analytic"`` (eigen-derivatives, :func:`point_jacobian`) or
+    ``"difference"`` (of the modal solves); default :data:`JACOBIAN`."""
+    problem = fit_problem(model, measured, adding, noise=noise, C=C, jacobian=jacobian)
+    base, slots, residual, effects_of = (problem.base, problem.slots, problem.residual,
+                                         problem.effects_of)
+    lower, upper, C = problem.lower, problem.upper, problem.residual.C
     n_res = measured.n_values
-    counter = {"n": 0}
-
-    def effects_of(z):
-        out, i = [], 0
-        for slot in slots:
-            k = len(slot.variables)
-            if k == 0:
-                out.append(Effect(slot.effect.name, slot.start))
-            else:
-                out.append(Effect(slot.effect.name, slot.effect.to_physical(
-                    base, slot.variables, z[i:i + k], slot.fixed)))
-            i += k
-        return out
-
-    def residual(z):
-        counter["n"] += 1
-        try:
-            trial = base.with_effects(effects_of(z), check=False)
-            r = residuals(trial, measured, noise, C)[0]
-        except (GfeInputError, ValueError, FloatingPointError, np.linalg.LinAlgError):
-            r = None
-        return np.full(n_res, FAILED_RESIDUAL) if r is None else r
 
     def chi2(z):
         return float(np.sum(residual(z) ** 2))
 
-    lower = np.array([v.lower for s in slots for v in s.variables])
-    upper = np.array([v.upper for s in slots for v in s.variables])
     # a given value is the only grid point of its variable; the others use their grid
     def grid_of(slot, start):
         return [(v.order_one(base, _value(start, v)),) if _has(start, v)
@@ -377,7 +552,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     return Fit(name=name or (slots[added[0]].effect.name if added else "baseline"),
                effects=tuple(effects), sigma=tuple(sigma), added=added[0] if added else None,
                model=fitted, misfit=fit_misfit, n_params=z.size, status=status,
-               success=success and np.isfinite(fit_misfit.chi2), evaluations=counter["n"],
+               success=success and np.isfinite(fit_misfit.chi2), evaluations=residual.count,
                equivalent=[tuple(effects_of(e)) for e in equivalent],
                unidentified=unidentified)
 
@@ -441,12 +616,15 @@ def _profile_starts(residual, chi2, z0, grids, slots, lower, upper) -> list:
         z = np.concatenate([z0[inner], point])
         r = residual(z)
         for _ in range(PROFILE_STEPS):
-            J = np.empty((r.size, inner.size))
-            for k in inner:
-                dz = z.copy()
-                h = 1e-6 * max(1.0, abs(z[k]))
-                dz[k] += h
-                J[:, k] = (residual(dz) - r) / h
+            if getattr(residual, "jacobian", None) is not None:
+                J = residual.jacobian(z, r, lower, upper)[:, inner]
+            else:
+                J = np.empty((r.size, inner.size))
+                for k in inner:
+                    dz = z.copy()
+                    h = 1e-6 * max(1.0, abs(z[k]))
+                    dz[k] += h
+                    J[:, k] = (residual(dz) - r) / h
             step = np.linalg.lstsq(J, -r, rcond=None)[0]
             trial = z.copy()
             trial[inner] = np.clip(z[inner] + step, lower[inner], upper[inner])
@@ -483,7 +661,7 @@ def _minimise(residual, chi2, z_start, lower, upper, max_iter):
     n = z.size
     for _ in range(MAX_RESTARTS):
         scale = max(value, 1.0)  # objective starts at 1/2: relative tolerances
-        objective = _GaussNewton(lambda zz, s=scale: residual(zz) / np.sqrt(s), n)
+        objective = _GaussNewton(residual, n, scale, lower, upper)
         x = ca.MX.sym("z", n)
         solver = ca.nlpsol("effects", "ipopt", {"x": x, "f": objective(x)},
                            {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
@@ -534,6 +712,14 @@ SOLVER_TALLY: Counter = Counter()
 
 
 def _jacobian(residual, z, r, lower, upper, step: float = 1e-5):
+    """The residual's own Jacobian (:class:`Objective`) or :func:`_difference_jacobian`."""
+    analytic = getattr(residual, "jacobian", None)
+    if analytic is not None:
+        return analytic(z, r, lower, upper)
+    return _difference_jacobian(residual, z, r, lower, upper, step)
+
+
+def _difference_jacobian(residual, z, r, lower, upper, step: float = 1e-5):
     """Second-order difference Jacobian (central; at a bound the one-sided three-point
     formula, stepping inwards): errors of ~1e-10 where forward differences err by 1e-6 times
     a residual's curvature-to-slope ratio, enough for the finish to certify its rule on
@@ -756,24 +942,39 @@ class _GaussNewton(ca.Callback):
     Hessian JᵀJ, J the forward-difference Jacobian of r, computed once per point and shared:
     IPOPT sees only n × n matrices, however many residuals there are."""
 
-    def __init__(self, fun, n: int, step: float = 1e-6):
+    def __init__(self, residual, n: int, scale: float, lower, upper, step: float = 1e-6):
         ca.Callback.__init__(self)
-        self.fun, self.n, self.step = fun, n, step
+        self.residual, self.n, self.step = residual, n, step
+        self.root = np.sqrt(scale)
+        self.lower, self.upper = lower, upper
         self._point = None
         self.construct("half_sum_of_squares", {})
+
+    def fun(self, z):
+        return self.residual(z) / self.root
 
     def residual_and_jacobian(self, z):
         key = z.tobytes()
         if self._point is None or self._point[0] != key:
             r0 = self.fun(z)
-            jac = np.zeros((r0.size, self.n))
-            for k in range(self.n):
-                dz = z.copy()
-                h = self.step * max(1.0, abs(z[k]))
-                dz[k] += h
-                jac[:, k] = (self.fun(dz) - r0) / h
+            analytic = getattr(self.residual, "jacobian", None)
+            if analytic is not None:   # IPOPT may step a hair outside the bounds
+                inside = np.clip(z, self.lower, self.upper)
+                jac = analytic(inside, r0, self.lower, self.upper) / self.root \
+                    if np.array_equal(inside, z) else self._forward(z, r0)
+            else:
+                jac = self._forward(z, r0)
             self._point = (key, r0, jac)
         return self._point[1], self._point[2]
+
+    def _forward(self, z, r0):
+        jac = np.zeros((r0.size, self.n))
+        for k in range(self.n):
+            dz = z.copy()
+            h = self.step * max(1.0, abs(z[k]))
+            dz[k] += h
+            jac[:, k] = (self.fun(dz) - r0) / h
+        return jac
 
     def get_n_in(self):
         return 1

@@ -27,14 +27,31 @@ the regularisation holds it at its initial value).
    with 45 sensors, and `update --add crack` with a sensor at every node on 1000 and 2000
    elements, each in a fresh process (wall time, peak resident memory).
 
-``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale.
+7. Fits (issue 22), ``--parts fits``: the issue's table measured twice side by side, each
+   run in fresh processes with the fits' Jacobian from finite differences of the modal solves
+   (``GFE_OPT_JACOBIAN=difference``, the old path) and analytic (eigen-derivatives, the
+   default): ``diagnose`` on 46 elements in process (best of 3, first and after adding the
+   crack), from the shell (``gfe-opt diagnose --json``, wall, best of 3, a 46-element beam
+   with a point mass), on 2000 elements; ``update --add crack`` on 46 elements (best of 3);
+   one set of a campaign (``batch --add material --add crack``, 2 workers, wall per set);
+   ``gfe-opt --version`` (best of 3); peak resident memory of each run.  Every fit of both
+   (every candidate of every diagnosis, the updates, the demo's and the shipped real data's
+   diagnoses, every batch row) is compared: largest relative difference of the parameters
+   and of χ² (targets 1e-6 and 1e-9).
+
+``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale, fits.
 """
 
 import argparse
 import json
 import multiprocessing as mp
+import os
 import resource
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -94,8 +111,13 @@ def _in_process(n, weighting="rows"):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-elements", type=int, default=10000)
-    parser.add_argument("--parts", default="update,ratio,solvers,accuracy,diagnose,scale")
+    parser.add_argument("--parts", default="update,ratio,solvers,accuracy,diagnose,scale,fits")
+    parser.add_argument("--fits-child", nargs=2, metavar=("JACOBIAN", "DIR"),
+                        help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.fits_child:
+        print(json.dumps(_fits_child(Path(args.fits_child[1]))))
+        return
     parts = set(args.parts.split(","))
     out = {}
     sizes = [n for n in (100, 300, 1000, 3000, 10000) if n <= args.max_elements]
@@ -114,6 +136,8 @@ def main():
         _diagnose(out)
     if "scale" in parts:
         _scale(out)
+    if "fits" in parts:
+        _fits(out)
     print(json.dumps(out, indent=1))
 
 
@@ -246,6 +270,156 @@ def _scale(out):
     ratio = {what: by[(2000, "45", what)]["seconds"] / by[(46, "45", what)]["seconds"]
              for what in ("diagnose", "update")}
     out["scale"] = {"rows": rows, "ratio_2000_over_46": ratio, "target": "<= 10"}
+
+
+# -------------------------------------------------------------------------------------------
+# 7. fits: finite-difference and analytic Jacobians side by side
+# -------------------------------------------------------------------------------------------
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _fit_rows(label, fits):
+    """(label/effect, parameters as a flat list, χ²) of each fit."""
+    rows = []
+    for fit in fits:
+        values = []
+        for effect in fit.effects:
+            for v in effect.parameters.values():
+                if not isinstance(v, str):
+                    values += [float(x) for x in np.atleast_1d(v)]
+        rows.append((f"{label}/{fit.name}", values, float(fit.misfit.chi2)))
+    return rows
+
+
+def _diagnosis_rows(label, d):
+    fits = list(d.fits) + ([d.together] if d.together is not None else [])
+    return _fit_rows(label, fits)
+
+
+def _best_of(fn, repeats=REPEATS):
+    runs, result = [], None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = fn()
+        runs.append(time.perf_counter() - start)
+    return min(runs), runs, result
+
+
+def _fits_child(work: Path) -> dict:
+    """One side of part 7 (the Jacobian chosen by GFE_OPT_JACOBIAN), in this process."""
+    from gfe_opt import fitting
+    from gfe_opt.batch import read_table, run_batch
+    from gfe_opt.diagnosis import diagnose, update
+    from gfe_opt.measured import load_measured
+    from gfe_opt.model import Effect, load_model
+    from gfe_opt.problems import problem_file
+    from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+
+    out, rows = {"jacobian": fitting.JACOBIAN}, []
+    noise = {"freq_noise": 0.0005, "shape_noise": 0.003}
+    model = load_model(problem_file("ss-steel-beam.toml"))
+    truth = model.with_effects([Effect("crack", {"position": 0.19, "depth_ratio": 0.5})])
+    measured = synthetic_measurement(truth, 5, interior_sensors(model.length, 45),
+                                     shape_noise=0.003, freq_noise=0.0005, seed=2002)
+    best, runs, upd = _best_of(lambda: update(model, measured, ["crack"], **noise))
+    out["update_46"] = {"best_s": best, "runs_s": runs}
+    rows += _fit_rows("update_46", [upd.fit])
+    for label, m in (("diagnose_46", model), ("diagnose_46_after_crack", upd.model)):
+        best, runs, d = _best_of(lambda m=m: diagnose(m, measured, realise=True, **noise))
+        out[label] = {"best_s": best, "runs_s": runs, "verdict": d.verdict}
+        rows += _diagnosis_rows(label, d)
+    big = model.with_elements(2000)
+    big_measured = synthetic_measurement(truth.with_elements(2000), 5,
+                                         interior_sensors(model.length, 45),
+                                         shape_noise=0.003, freq_noise=0.0005, seed=2002,
+                                         reference_elements=4000)
+    best, runs, d = _best_of(lambda: diagnose(big, big_measured, realise=True, **noise), 1)
+    out["diagnose_2000"] = {"best_s": best, "verdict": d.verdict}
+    rows += _diagnosis_rows("diagnose_2000", d)
+    demo = load_measured(problem_file("demo-measured.json"))
+    best, runs, d = _best_of(lambda: diagnose(model, demo, realise=True, **noise), 1)
+    out["diagnose_demo"] = {"best_s": best, "verdict": d.verdict}
+    rows += _diagnosis_rows("diagnose_demo", d)
+    real_model = load_model(problem_file("hr-cantilever.toml"))
+    real = load_measured(problem_file("hr-cantilever.csv"))
+    best, runs, d = _best_of(lambda: diagnose(real_model, real, realise=True), 1)
+    out["diagnose_real"] = {"best_s": best, "verdict": d.verdict}
+    rows += _diagnosis_rows("diagnose_real", d)
+    table = work / f"batch-{fitting.JACOBIAN}.csv"
+    sets = sorted((work / "sets").glob("*.json"))
+    start = time.perf_counter()
+    run_batch(problem_file("ss-steel-beam.toml"), work / "sets", table,
+              add=["material", "crack"], workers=2, force=True)
+    out["batch_per_set"] = {"wall_s_per_set": (time.perf_counter() - start) / len(sets),
+                            "sets": len(sets), "workers": 2}
+    for row in read_table(table):
+        values = [float(v) for k, v in sorted(row.items())
+                  if k.endswith((".E", ".position", ".depth_ratio")) and v is not None]
+        rows.append((f"batch/{row['file']}", values, float(row["chi2_per_residual"])))
+    shell = [sys.executable, "-m", "gfe_opt", "diagnose", str(work / "mass-model.toml"),
+             str(work / "mass-measured.json"), "--json"]
+    best, runs, _ = _best_of(lambda: subprocess.run(shell, capture_output=True, check=True))
+    out["shell_diagnose_46"] = {"best_s": best, "runs_s": runs}
+    out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    out["fits"] = rows
+    return out
+
+
+def _fits(out):
+    from gfe_opt.measured import save_measured
+    from gfe_opt.model import Effect, load_model, save_model
+    from gfe_opt.problems import problem_file
+    from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+
+    sys.path.insert(0, str(ROOT))
+    from tests.truths import write_campaign
+
+    work = Path(tempfile.mkdtemp(prefix="gfe-bench-fits-"))
+    model = load_model(problem_file("ss-steel-beam.toml"))
+    write_campaign(model, work / "sets", 10, seed=3)
+    save_model(model.with_effects([]), work / "mass-model.toml")
+    mass = model.with_effects([Effect("point_mass", {"position": 0.41, "mass": 0.05})])
+    save_measured(synthetic_measurement(mass, 5, interior_sensors(model.length, 45),
+                                        shape_noise=0.003, freq_noise=0.0005, seed=5),
+                  work / "mass-measured.json")
+    sides = {}
+    for jacobian in ("difference", "analytic"):
+        env = {**os.environ, "GFE_OPT_JACOBIAN": jacobian}
+        run = subprocess.run([sys.executable, __file__, "--fits-child", jacobian, str(work)],
+                             capture_output=True, text=True, env=env, check=True)
+        sides[jacobian] = json.loads(run.stdout.strip().splitlines()[-1])
+        print(f"fits ({jacobian}): done", file=sys.stderr, flush=True)
+    version = [sys.executable, "-m", "gfe_opt", "--version"]
+    best, runs, _ = _best_of(lambda: subprocess.run(version, capture_output=True, check=True))
+    a, b = sides["difference"], sides["analytic"]
+    worst_param, worst_chi2, compared = 0.0, 0.0, 0
+    for (la, va, ca), (lb, vb, cb) in zip(a["fits"], b["fits"]):
+        if la != lb or len(va) != len(vb):
+            worst_param = float("inf")
+            continue
+        compared += 1
+        for x, y in zip(va, vb):
+            worst_param = max(worst_param, abs(x - y) / max(abs(x), abs(y), 1e-300))
+        worst_chi2 = max(worst_chi2, abs(ca - cb) / max(abs(ca), abs(cb), 1e-300))
+    table = {}
+    for key, goal in (("diagnose_46", 0.5), ("diagnose_46_after_crack", 0.5),
+                      ("shell_diagnose_46", 1.2), ("diagnose_2000", 3.0), ("update_46", 0.1),
+                      ("batch_per_set", 0.15)):
+        field = "wall_s_per_set" if key == "batch_per_set" else "best_s"
+        table[key] = {"difference_s": round(a[key][field], 3),
+                      "analytic_s": round(b[key][field], 3),
+                      "speedup": round(a[key][field] / b[key][field], 2), "goal_s": goal}
+    table["version_startup"] = {"best_s": round(best, 3), "goal_s": 0.3}
+    out["fits"] = {"table": table,
+                   "fits_compared": compared,
+                   "same_fits": len(a["fits"]) == len(b["fits"]),
+                   "max_parameter_rel_difference": worst_param, "target_parameters": 1e-6,
+                   "max_chi2_rel_difference": worst_chi2, "target_chi2": 1e-9,
+                   "verdicts": {k: (a[k].get("verdict"), b[k].get("verdict"))
+                                for k in a if isinstance(a[k], dict) and "verdict" in a[k]},
+                   "peak_rss_mb": {"difference": round(a["peak_rss_mb"], 1),
+                                   "analytic": round(b["peak_rss_mb"], 1)}}
 
 
 if __name__ == "__main__":
