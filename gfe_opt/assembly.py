@@ -21,6 +21,7 @@ Effects do not touch matrices themselves: each tells a :class:`Builder` what it 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from typing import Callable
 
 import numpy as np
@@ -121,11 +122,10 @@ class Discretisation:
 
     def assemble_elements(self, matrices) -> sp.csr_matrix:
         """Sum element matrices (n_elements, n, n) into a global sparse matrix."""
-        dofs = self.element_dofs()
-        rows = np.repeat(dofs, dofs.shape[1], axis=1).ravel()
-        cols = np.tile(dofs, (1, dofs.shape[1])).ravel()
-        return sp.csr_matrix((np.asarray(matrices).ravel(), (rows, cols)),
-                             shape=(self.n_dof, self.n_dof))
+        slot, indices, indptr = _assembly_pattern(self.n_elements, self.dofs_per_node)
+        data = np.bincount(slot, weights=np.asarray(matrices, dtype=float).ravel(),
+                           minlength=indices.size)
+        return sp.csr_matrix((data, indices, indptr), shape=(self.n_dof, self.n_dof))
 
     def global_matrices(self, params=None) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """Global (K, M) over all DOFs, boundary conditions not applied."""
@@ -135,6 +135,27 @@ class Discretisation:
             K = K + sp.csr_matrix((val, (dof, dof)), shape=K.shape)
         M = self.assemble_elements(self.mass)
         return K.tocsr(), M.tocsr()
+
+
+@lru_cache(maxsize=16)
+def _assembly_pattern(n_elements: int, per_node: int):
+    """Where each entry of the element matrices lands in the global CSR data: (slot per
+    element entry, indices, indptr), computed once per mesh (the fits assemble thousands of
+    times; building the pattern each time cost more than the arithmetic)."""
+    dofs = np.arange(n_elements)[:, None] * per_node + np.arange(2 * per_node)[None, :]
+    rows = np.repeat(dofs, dofs.shape[1], axis=1).ravel()
+    cols = np.tile(dofs, (1, dofs.shape[1])).ravel()
+    n_dof = per_node * (n_elements + 1)
+    pattern = sp.csr_matrix((np.arange(1, rows.size + 1, dtype=float), (rows, cols)),
+                            shape=(n_dof, n_dof))
+    pattern.sort_indices()
+    key = rows.astype(np.int64) * n_dof + cols
+    position = np.repeat(np.arange(n_dof), np.diff(pattern.indptr)).astype(np.int64) * n_dof \
+        + pattern.indices
+    slot = np.searchsorted(position, key)
+    for array in (slot, pattern.indices, pattern.indptr):
+        array.setflags(write=False)
+    return slot, pattern.indices, pattern.indptr
 
 
 def constrained_dofs(model: Model) -> np.ndarray:

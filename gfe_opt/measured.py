@@ -34,6 +34,7 @@ import itertools
 import json
 from dataclasses import dataclass, replace
 from datetime import datetime
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -545,6 +546,23 @@ def on_model(measured: MeasuredModes, model) -> tuple[MeasuredModes, list[str]]:
                   "the structure still: left out (it reads only noise)"]
 
 
+@lru_cache(maxsize=32)
+def _element_to_node(n_el: int) -> sp.csr_matrix:
+    """Cubic Lagrange interpolation (n_el + 1, n_el) from element middles to the nodes, the
+    four nearest elements (fewer on a shorter beam); a fit asks for it at every step."""
+    k = min(4, n_el)
+    rows, cols, vals = [], [], []
+    for i in range(n_el + 1):
+        first = min(max(i - 2, 0), n_el - k)
+        mid = first + 0.5 + np.arange(k)
+        for a in range(k):
+            others = np.delete(mid, a)
+            rows.append(i)
+            cols.append(first + a)
+            vals.append(np.prod((i - others) / (mid[a] - others)))
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n_el + 1, n_el))
+
+
 def _shear_sensor_matrix(n_el, L, e, xi, shear_g) -> sp.csr_matrix:
     r"""Deflection at sensors of a Timoshenko beam: cubic Hermite in w with nodal slopes
     :math:`w' = θ + γ`, θ the section rotation and γ the shear strain at the node.
@@ -567,17 +585,7 @@ def _shear_sensor_matrix(n_el, L, e, xi, shear_g) -> sp.csr_matrix:
     strain = sp.csr_matrix(((c[:, None] * np.array([-1.0 / L, -0.5, 1.0 / L, -0.5])).ravel(),
                             (np.repeat(np.arange(n_el), 4), cols.ravel())),
                            shape=(n_el, n_dof))
-    k = min(4, n_el)
-    rows, cols, vals = [], [], []
-    for i in range(n_nodes):
-        first = min(max(i - 2, 0), n_el - k)
-        mid = first + 0.5 + np.arange(k)
-        for a in range(k):
-            others = np.delete(mid, a)
-            rows.append(i)
-            cols.append(first + a)
-            vals.append(np.prod((i - others) / (mid[a] - others)))
-    nodal = sp.csr_matrix((vals, (rows, cols)), shape=(n_nodes, n_el)) @ strain
+    nodal = _element_to_node(n_el) @ strain
     pick = np.arange(n_nodes)
     w = sp.csr_matrix((np.ones(n_nodes), (pick, 2 * pick)), shape=(n_nodes, n_dof))
     slope = sp.csr_matrix((np.ones(n_nodes), (pick, 2 * pick + 1)),

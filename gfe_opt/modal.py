@@ -148,6 +148,13 @@ def peak_rows(shapes) -> np.ndarray:
     return np.argmax(a >= (1.0 - PEAK_TIE) * np.max(a, axis=0), axis=0)
 
 
+def condensed(model) -> bool:
+    """Whether the modes of ``model`` (a Model or a Discretisation) come from the condensed
+    route (:func:`_condensed_modes`)."""
+    n = model.elements if hasattr(model, "elements") else model.n_elements
+    return model.kind == "beam" and n > CONDENSE_ABOVE
+
+
 def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
                          matrices=None) -> Modes:
     """Modes of a discretisation, optionally with replaced generic stiffness parameters,
@@ -157,7 +164,7 @@ def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
     strain energy summed element by element (:meth:`Discretisation.strain_energy`).
     ``matrices`` may pass (K, M) already assembled (used by the direct route).
     """
-    if disc.kind == "beam" and disc.n_elements > CONDENSE_ABOVE:
+    if condensed(disc):
         return _condensed_modes(disc, n_modes, params)
     K, M = disc.global_matrices(params) if matrices is None else matrices
     modes = solve_modes(K, M, n_modes, disc.constrained, disc.eigenvalue_scale)

@@ -85,21 +85,34 @@ def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None):
         rhs_top = -g + np.outer(Mx, dlam[j])
         border = d * Mx
         beta = 1.0 / np.linalg.norm(border)
-        rhs = np.vstack([d[:, None] * rhs_top, beta * half[None, :]])
         try:
             if dense:
+                rhs = np.vstack([d[:, None] * rhs_top, beta * half[None, :]])
                 A = np.zeros((free.size + 1, free.size + 1))
                 A[:-1, :-1] = Ks - lam[j] * Ms
                 A[:-1, -1] = A[-1, :-1] = beta * border
                 sol = np.linalg.solve(A, rhs)
+                dphi[free, j, :] = d[:, None] * sol[:-1]
             else:
-                A = sp.bmat([[Ks - lam[j] * Ms, sp.csc_matrix(beta * border[:, None])],
-                             [sp.csr_matrix(beta * border[None, :]), None]], format="csc")
-                sol = spla.splu(A).solve(rhs)
+                dphi[free, j, :] = _nelson(Ks - lam[j] * Ms, x / d, d, rhs_top, Mx, half)
         except (RuntimeError, np.linalg.LinAlgError) as exc:  # singular: a repeated one
             raise RepeatedEigenvalue(str(exc)) from exc
-        dphi[free, j, :] = d[:, None] * sol[:-1]
     return dlam, dphi
+
+
+def _nelson(As, xs, d, rhs_top, Mx, half):
+    """Nelson's method on a sparse model: the scaled (K − λM) with the row and column of
+    the shape's largest (scaled) entry removed is nonsingular and keeps its sparsity (a
+    bordered matrix's dense row and column made the factorisation 50 times slower on 4 000
+    DOFs); v solves it with v_k = 0, and φ′ = v + cφ with c from the normalisation."""
+    k = int(np.argmax(np.abs(xs)))
+    keep = np.flatnonzero(np.arange(xs.size) != k)
+    A = As.tocsc()[keep][:, keep]
+    v = np.zeros((xs.size, rhs_top.shape[1]))
+    v[keep] = spla.splu(A.tocsc()).solve(d[keep, None] * rhs_top[keep])
+    v = d[:, None] * v                                  # back to physical coordinates
+    c = half - Mx @ v
+    return v + np.outer(d * xs, c)
 
 
 def _as(A, dense: bool):

@@ -280,21 +280,27 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _fit_rows(label, fits):
-    """(label/effect, parameters as a flat list, χ²) of each fit."""
+    """(label/effect, parameters as a flat list, their σ, χ²) of each fit."""
     rows = []
     for fit in fits:
-        values = []
-        for effect in fit.effects:
-            for v in effect.parameters.values():
+        values, sigmas = [], []
+        for effect, sigma in zip(fit.effects, fit.sigma):
+            for key, v in effect.parameters.items():
                 if not isinstance(v, str):
                     values += [float(x) for x in np.atleast_1d(v)]
-        rows.append((f"{label}/{fit.name}", values, float(fit.misfit.chi2)))
+                    s = sigma.get(key)
+                    sigmas += ([float("nan")] * np.atleast_1d(v).size if s is None
+                               else [float(x) for x in np.atleast_1d(s)])
+        rows.append((f"{label}/{fit.name}", values, sigmas, float(fit.misfit.chi2)))
     return rows
 
 
 def _diagnosis_rows(label, d):
+    """Every fit of a diagnosis (the failed ones marked: a fit may converge on one path and
+    not on the other)."""
     fits = list(d.fits) + ([d.together] if d.together is not None else [])
-    return _fit_rows(label, fits)
+    return _fit_rows(label, fits) + [(f"{label}/{f.name} (failed)", [], [], float("nan"))
+                                     for f in d.failed]
 
 
 def _best_of(fn, repeats=REPEATS):
@@ -356,7 +362,8 @@ def _fits_child(work: Path) -> dict:
     for row in read_table(table):
         values = [float(v) for k, v in sorted(row.items())
                   if k.endswith((".E", ".position", ".depth_ratio")) and v is not None]
-        rows.append((f"batch/{row['file']}", values, float(row["chi2_per_residual"])))
+        rows.append((f"batch/{row['file']}", values, [float("nan")] * len(values),
+                     float(row["chi2_per_residual"])))
     shell = [sys.executable, "-m", "gfe_opt", "diagnose", str(work / "mass-model.toml"),
              str(work / "mass-measured.json"), "--json"]
     best, runs, _ = _best_of(lambda: subprocess.run(shell, capture_output=True, check=True))
@@ -393,15 +400,22 @@ def _fits(out):
     version = [sys.executable, "-m", "gfe_opt", "--version"]
     best, runs, _ = _best_of(lambda: subprocess.run(version, capture_output=True, check=True))
     a, b = sides["difference"], sides["analytic"]
-    worst_param, worst_chi2, compared = 0.0, 0.0, 0
-    for (la, va, ca), (lb, vb, cb) in zip(a["fits"], b["fits"]):
-        if la != lb or len(va) != len(vb):
-            worst_param = float("inf")
+    worst_param, worst_sigma, worst_chi2, compared, differ = 0.0, 0.0, 0.0, 0, []
+    by_label = {row[0]: row for row in b["fits"]}
+    for la, va, sa, ca in a["fits"]:
+        other = by_label.pop(la, None)
+        if other is None or len(other[1]) != len(va):
+            differ.append(la)
             continue
+        _, vb, sb, cb = other
         compared += 1
-        for x, y in zip(va, vb):
+        for x, y, s in zip(va, vb, sa):
             worst_param = max(worst_param, abs(x - y) / max(abs(x), abs(y), 1e-300))
-        worst_chi2 = max(worst_chi2, abs(ca - cb) / max(abs(ca), abs(cb), 1e-300))
+            if np.isfinite(s) and s > 0:
+                worst_sigma = max(worst_sigma, abs(x - y) / s)
+        if np.isfinite(ca) and np.isfinite(cb):
+            worst_chi2 = max(worst_chi2, abs(ca - cb) / max(abs(ca), abs(cb), 1e-300))
+    differ += sorted(by_label)
     table = {}
     for key, goal in (("diagnose_46", 0.5), ("diagnose_46_after_crack", 0.5),
                       ("shell_diagnose_46", 1.2), ("diagnose_2000", 3.0), ("update_46", 0.1),
@@ -413,8 +427,9 @@ def _fits(out):
     table["version_startup"] = {"best_s": round(best, 3), "goal_s": 0.3}
     out["fits"] = {"table": table,
                    "fits_compared": compared,
-                   "same_fits": len(a["fits"]) == len(b["fits"]),
+                   "fits_on_one_side_only": differ,
                    "max_parameter_rel_difference": worst_param, "target_parameters": 1e-6,
+                   "max_parameter_difference_in_sigma": worst_sigma,
                    "max_chi2_rel_difference": worst_chi2, "target_chi2": 1e-9,
                    "verdicts": {k: (a[k].get("verdict"), b[k].get("verdict"))
                                 for k in a if isinstance(a[k], dict) and "verdict" in a[k]},
