@@ -578,21 +578,34 @@ def _shear_sensor_matrix(n_el, L, e, xi, shear_g) -> sp.csr_matrix:
     Hermite.  Taking θ as the slope does not converge at all at fixed κGA (off by 1.8 % in
     that mode), the element's own interdependent functions (constant γ) are O(h²) (1 %).
     """
-    n_nodes, n_dof = n_el + 1, 2 * (n_el + 1)
     c = np.broadcast_to(np.asarray(shear_g, float), (n_el,))
     c = c / (1.0 + c)
+    fixed, P, unit_strain = _shear_sensor_parts(n_el, float(L), e.tobytes(), xi.tobytes())
+    return (fixed + (P @ sp.diags(c)) @ unit_strain).tocsr()
+
+
+@lru_cache(maxsize=64)
+def _shear_sensor_parts(n_el, L, e_bytes, xi_bytes):
+    """The sensor matrix of :func:`_shear_sensor_matrix` is C = C₀ + P diag(c) S: C₀ plain
+    Hermite with θ as the slope, P (sensors × elements) the slope shape functions times
+    the element-to-node interpolation, S each element's unit shear strain.  A fit asks for
+    it at every step with another c; its parts are made once per mesh and sensor set."""
+    e = np.frombuffer(e_bytes, dtype=int)
+    xi = np.frombuffer(xi_bytes, dtype=float)
+    n_nodes, n_dof = n_el + 1, 2 * (n_el + 1)
     cols = 2 * np.arange(n_el)[:, None] + np.arange(4)
-    strain = sp.csr_matrix(((c[:, None] * np.array([-1.0 / L, -0.5, 1.0 / L, -0.5])).ravel(),
-                            (np.repeat(np.arange(n_el), 4), cols.ravel())),
-                           shape=(n_el, n_dof))
-    nodal = _element_to_node(n_el) @ strain
+    unit_strain = sp.csr_matrix((np.tile(np.array([-1.0 / L, -0.5, 1.0 / L, -0.5]), n_el),
+                                 (np.repeat(np.arange(n_el), 4), cols.ravel())),
+                                shape=(n_el, n_dof))
     pick = np.arange(n_nodes)
     w = sp.csr_matrix((np.ones(n_nodes), (pick, 2 * pick)), shape=(n_nodes, n_dof))
-    slope = sp.csr_matrix((np.ones(n_nodes), (pick, 2 * pick + 1)),
-                          shape=(n_nodes, n_dof)) + nodal
+    theta = sp.csr_matrix((np.ones(n_nodes), (pick, 2 * pick + 1)), shape=(n_nodes, n_dof))
     H = el.hermite(xi)
-    return (sp.diags(H[:, 0]) @ w[e] + sp.diags(L * H[:, 1]) @ slope[e]
-            + sp.diags(H[:, 2]) @ w[e + 1] + sp.diags(L * H[:, 3]) @ slope[e + 1]).tocsr()
+    fixed = (sp.diags(H[:, 0]) @ w[e] + sp.diags(L * H[:, 1]) @ theta[e]
+             + sp.diags(H[:, 2]) @ w[e + 1] + sp.diags(L * H[:, 3]) @ theta[e + 1]).tocsr()
+    nodes = _element_to_node(n_el)
+    P = (sp.diags(L * H[:, 1]) @ nodes[e] + sp.diags(L * H[:, 3]) @ nodes[e + 1]).tocsr()
+    return fixed, P, unit_strain
 
 
 def observation(disc, measured) -> sp.csr_matrix:
