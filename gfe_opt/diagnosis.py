@@ -52,8 +52,7 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import chdtri
-from scipy.stats import norm
+from scipy.special import chdtri, ndtri
 
 from .correlation import check_model_size, check_units, compare
 from .effects import candidate_names, effect_type
@@ -85,7 +84,7 @@ SIGNIFICANCE_LEVEL = 0.999
 #: a significant effect lies this many standard deviations from "no effect"
 SIZE_SIGMAS = 3.0
 #: two-sided normal quantile of the whiteness test of the shape residuals (α = 10⁻³)
-WHITE_NOISE_Z = float(norm.isf(0.5 * (1.0 - SIGNIFICANCE_LEVEL)))
+WHITE_NOISE_Z = float(-ndtri(0.5 * (1.0 - SIGNIFICANCE_LEVEL)))  # normal quantile
 #: a frequency-only test with no noise given: frequencies off by more than this many times
 #: the assumed noise (0.05 %: 0.2 % rms) are not called noise.  An assumption, not derived:
 #: frequencies alone carry no test of their own noise (with shapes, the whiteness of the
