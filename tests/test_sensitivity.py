@@ -11,8 +11,8 @@ import pytest
 from gfe_opt.effects import EFFECTS, effect_type
 from gfe_opt.fitting import Noise, fit_problem
 from gfe_opt.measured import make_measured
-from gfe_opt.model import Effect
 from gfe_opt.modal import model_modes
+from gfe_opt.model import Effect
 from gfe_opt.sensitivity import RepeatedEigenvalue, eigen_derivatives
 
 from .conftest import STEEL_BAR, make_model
