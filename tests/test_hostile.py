@@ -7,6 +7,7 @@ import subprocess
 import sys
 import time
 import tomllib
+from pathlib import Path
 
 import pytest
 
@@ -149,15 +150,36 @@ def test_concurrent_writers_leave_one_complete_file(files, tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["u.toml"]
 
 
+def _group_members(pgid: int) -> list[int]:
+    """Processes of a process group (Linux /proc), the leader included."""
+    members = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[2]) == pgid:
+            members.append(int(stat.parent.name))
+    return members
+
+
 def test_ctrl_c_is_one_line_exit_130_no_file_no_worker_left(files, tmp_path):
     _, model, measured = files
+    # a finer model than the fixture's: the diagnosis lasts long enough to be interrupted
+    # however fast the fits (the fixed 2 s wait came after the end once fits were faster)
+    fine = tmp_path / "fine.toml"
+    fine.write_text(model.read_text().replace("elements = 46", "elements = 150"))
     report = tmp_path / "r.html"
     run = subprocess.Popen([sys.executable, "-c", "import sys; from gfe_opt.entry import main;"
-                            " sys.exit(main())", "diagnose", str(model), str(measured),
+                            " sys.exit(main())", "diagnose", str(fine), str(measured),
                             "--report", str(report)],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                            start_new_session=True)
-    time.sleep(2.0)  # inside the candidate fits
+    deadline = time.monotonic() + 60
+    while len(_group_members(run.pid)) < 2 and run.poll() is None:  # until workers fit
+        assert time.monotonic() < deadline, "no worker started"
+        time.sleep(0.05)
+    time.sleep(0.3)  # inside the candidate fits
     os.killpg(run.pid, signal.SIGINT)
     _, err = run.communicate(timeout=60)
     assert run.returncode == 130 and err.count("\n") == 1 and "interrupted" in err, err
