@@ -13,8 +13,10 @@ nonsingular equation; Lee & Jung 1997)
     \begin{bmatrix} φ' \\ μ \end{bmatrix} =
     \begin{bmatrix} -(K' - λ M')φ + λ' Mφ \\ -\tfrac12 φ^T M' φ \end{bmatrix}
 
-(μ = 0 at the solution), exact for any number of parameters with one sparse factorisation
-per mode.  The system is nonsingular exactly when λ is simple: a mode within
+(μ = 0 at the solution), exact for any number of parameters with one factorisation per
+mode: dense (LAPACK) up to :data:`DENSE_DOFS` free DOFs; above, Nelson's own form (the
+row and column of the shape's largest entry removed, a sparse LU that keeps the band) with
+the same result.  The system is nonsingular exactly when λ is simple: a mode within
 :data:`REPEATED_GAP` (relative) of another has no derivative of its shape (any combination of
 the pair is an eigenvector) and :func:`eigen_derivatives` raises :class:`RepeatedEigenvalue`.
 
