@@ -545,8 +545,11 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
 
     partial = together = None
     suggested, offered = [], []
-    if best is not None and not explains(best) or best is None and not fits_noise(
-            ref_misfit, ref_params):
+    # a free profile may explain significantly more whenever the best does not bring χ² to
+    # the noise (stated or assumed): residuals that look white with no noise given do not
+    # rule it out (a quadratic taper read as one long zone, the rest then chased by more)
+    if best is not None and not fits_noise(best.misfit, best.n_params) or best is None \
+            and not fits_noise(ref_misfit, ref_params):
         profile = (_fallback(model, measured, noise, fallback_names, sel, band, progress)
                    if fallback_names else None)
         if profile is not None:
@@ -554,8 +557,12 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             _judge([*fits, profile], sel, material, model)
             best = _best(fits, sel)
             fits.append(profile)
-        if best is not None and not explains(best):
-            first, pair = _lookahead(model, measured, noise, best, fits, hint, explains, sel)
+        explained = best is not None and explains(best)
+        profile_wins = (best is not None and profile is not None and profile.significant
+                        and sel.better(profile, best))
+        if best is not None and (not explained or profile_wins):
+            first, pair = (_lookahead(model, measured, noise, best, fits, hint, explains, sel)
+                           if not explained else (best, None))
             if pair is not None and profile is not None and profile.success \
                     and not profile.failed and sel.better(profile, pair):
                 pair = None   # a free profile explains significantly more than the pair
@@ -579,6 +586,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                     f.significant = False
             # else: the best named effect is the finding, and what remains after it is said
             # (``remaining``): the next diagnosis works on it
+        elif explained and profile is not None:
+            profile.significant = False  # named effects win where they explain
         if profile is not None and profile.significant and not explains(profile):
             if partial is None and (best is None or not best.significant):
                 partial = profile

@@ -468,6 +468,38 @@ class FitProblem:
         return out
 
 
+    def canonical(self, z) -> np.ndarray:
+        """``z`` with each slot's variables as its effect lies on the structure
+        (:meth:`~gfe_opt.effects.base.EffectType.to_physical`); unchanged where they
+        already are."""
+        z = np.array(z, dtype=float)
+        i = 0
+        for slot in self.slots:
+            k = len(slot.variables)
+            if k:
+                params = slot.effect.to_physical(self.base, slot.variables, z[i:i + k],
+                                                 slot.fixed)
+                again = slot.effect.to_variables(self.base, slot.variables, params)
+                if np.max(np.abs(again - z[i:i + k])) > 1e-12:
+                    z[i:i + k] = again
+            i += k
+        return z
+
+
+    def untied(self, z) -> np.ndarray:
+        """``z`` moved off the kinks of its effects (:meth:`EffectType.untie`: a zone with
+        an edge on an end starts past it), the same structure; a fit started on a kink
+        could not certify its stopping rule."""
+        z = np.array(z, dtype=float)
+        i = 0
+        for slot in self.slots:
+            k = len(slot.variables)
+            if k:
+                z[i:i + k] = slot.effect.untie(self.base, slot.variables, z[i:i + k])
+            i += k
+        return np.clip(z, self.lower, self.upper)
+
+
 def fit_problem(model: Model, measured: MeasuredModes, adding=(), *, noise: Noise, C=None,
                 jacobian: str | None = None) -> FitProblem:
     """The :class:`FitProblem` of :func:`fit_effects` (same arguments)."""
@@ -524,6 +556,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     for alt in alternatives:
         starts.append(np.clip(_grid_start(chi2, grids[:-1] + [grid_of(slots[-1], alt)]),
                               lower, upper))
+    starts = [problem.untied(s) for s in starts]
     status, success = "Nothing_To_Fit", True
     z = starts[0]
     ends, equivalent = [], []
@@ -542,6 +575,9 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
             more = [s for s in starts if s is not first] if multistart is True else []
             more += _profile_starts(residual, chi2, first, grids, slots, lower, upper)
             ends += [_minimise(residual, chi2, z0, lower, upper, max_iter) for z0 in more]
+        # each end as its effects lie on the structure (a zone fitted past an end: the part
+        # on it), so that ends that are one structure compare equal
+        ends = [(problem.canonical(e[0]), *e[1:]) for e in ends]
         # the best converged end (ends within rounding of each other: the first one)
         converged = [e for e in ends if e[3]] or ends
         z, value, status, success = converged[lowest([e[1] for e in converged])]
@@ -851,25 +887,43 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper):
     if n == 0 or not np.isfinite(fit_misfit.chi2):
         return out, []
     r0 = residual(z)
-    # second-order differences: forward ones (step 1e-6) gave σ that moved by 1e-3 between
-    # two optima 1e-4 σ apart (a section loss on the demo), a printed digit at 99.95 σ
-    J = _jacobian(residual, z, r0, lower, upper, step=1e-4)
+    T, tied_names, tied_owner = _ties(slots, base, z)
+    if T is None:
+        # second-order differences: forward ones (step 1e-6) gave σ that moved by 1e-3
+        # between two optima 1e-4 σ apart (a section loss on the demo), a printed digit at
+        # 99.95 σ
+        J = _jacobian(residual, z, r0, lower, upper, step=1e-4)
+    else:
+        # an effect with a tie (a zone with an edge on an end) is differenced along the
+        # directions it can move in: across the tie the residual has a kink
+        lo, hi = _tied_bounds(T, z, lower, upper)
+        J = _difference_jacobian(lambda y: residual(z + T @ y), np.zeros(T.shape[1]), r0,
+                                 lo, hi, step=1e-4)
+    m = J.shape[1]
     A = J.T @ J
     ridge = 1e-12 * max(float(np.max(np.diag(A))), 1e-300)
     s2 = max(1.0, fit_misfit.chi2 / max(fit_misfit.n_residuals - n, 1))
     try:
-        cov = s2 * np.linalg.inv(A + ridge * np.eye(n))
+        cov = s2 * np.linalg.inv(A + ridge * np.eye(m))
     except np.linalg.LinAlgError:
-        cov = np.full((n, n), np.inf)
+        cov = np.full((m, m), np.inf)
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     sd = np.where(np.diag(A) > 1e-9 * max(float(np.max(np.diag(A))), 1e-300), sd, np.inf)
+    if T is not None:   # σ of the variables themselves; a held one is not determined
+        cov_z = T @ np.where(np.isfinite(cov), cov, 0.0) @ T.T
+        sd_z = np.sqrt(np.maximum(np.diag(cov_z), 0.0))
+        moves = np.abs(T) > 0
+        sd_z = np.where(moves.any(axis=1) & ~(moves & ~np.isfinite(sd)).any(axis=1), sd_z,
+                        np.inf)
+    else:
+        sd_z = sd
     names, unidentified = [], []
     i = 0
     for j, slot in enumerate(slots):
         for v in slot.variables:
             phys = v.physical(base, z[i])
             derivative = phys * np.log(10.0) if v.log else v.scale(base)
-            value = abs(derivative) * sd[i]
+            value = abs(derivative) * sd_z[i]
             if v.index is None:
                 out[j][v.key] = float(value)
             else:
@@ -884,14 +938,54 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper):
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(sd, sd)
     owner = [k for k, slot in enumerate(slots) for _ in slot.variables]
-    added = {i for i, k in enumerate(owner) if slots[k].added} or set(range(n))
-    for a in range(n):
-        for b in range(a + 1, n):
+    if T is not None:   # correlations of the directions the effects move in
+        names, owner = tied_names, tied_owner
+    added = {i for i, k in enumerate(owner) if slots[k].added} or set(range(m))
+    for a in range(m):
+        for b in range(a + 1, m):
             if (a in added or b in added) and np.isfinite(corr[a, b]) \
                     and abs(corr[a, b]) > IDENTIFIABLE_CORRELATION:
                 unidentified.append(f"{names[a]} and {names[b]} trade against each other "
                                     f"(correlation {corr[a, b]:+.3f})")
     return out, unidentified
+
+
+def _ties(slots, base, z):
+    """The directions the variables move in (:meth:`EffectType.tie`) as one matrix T
+    (variables × directions), their labels and owning slots; (None, None, None) when every
+    variable moves freely."""
+    blocks, labels, owner, i, any_tie = [], [], [], 0, False
+    for j, slot in enumerate(slots):
+        k = len(slot.variables)
+        tie = slot.effect.tie(base, slot.variables, z[i:i + k]) if k else None
+        if tie is None:
+            blocks.append(np.eye(k))
+            labels += [f"{slot.effect.name}.{v.label}" for v in slot.variables]
+        else:
+            any_tie = True
+            blocks.append(tie[0])
+            labels += [f"{slot.effect.name}.{name}" for name in tie[1]]
+        owner += [j] * blocks[-1].shape[1]
+        i += k
+    if not any_tie:
+        return None, None, None
+    rows = sum(b.shape[0] for b in blocks)
+    T = np.zeros((rows, sum(b.shape[1] for b in blocks)))
+    r = c = 0
+    for b in blocks:
+        T[r:r + b.shape[0], c:c + b.shape[1]] = b
+        r, c = r + b.shape[0], c + b.shape[1]
+    return T, labels, owner
+
+
+def _tied_bounds(T, z, lower, upper):
+    """How far each direction of T may move from z within the variables' bounds."""
+    lo, hi = np.full(T.shape[1], -np.inf), np.full(T.shape[1], np.inf)
+    for j in range(T.shape[1]):
+        for i in np.flatnonzero(T[:, j]):
+            a, b = (lower[i] - z[i]) / T[i, j], (upper[i] - z[i]) / T[i, j]
+            lo[j], hi[j] = max(lo[j], min(a, b)), min(hi[j], max(a, b))
+    return lo, hi
 
 
 def _with_null(effect: EffectType, v, base) -> tuple:

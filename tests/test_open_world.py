@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from gfe_opt.assembly import rigidity_function
+from gfe_opt.diagnosis import diagnose, update
 from gfe_opt.fitting import fit_effects, noise_of
 from gfe_opt.measured import make_measured
 from gfe_opt.model import Effect
@@ -44,6 +45,37 @@ def test_a_taper_becomes_a_stiffness_profile_not_local_effects():
     assert np.max(np.abs(rigidity(x) / (model.E * model.inertia) / (1 - 0.2 * x / L) - 1)) < 0.03
     # the generic update calls it a taper, and the fit reproduces it
     assert any("a taper" in w for w in loop_words(make_model(), measured))
+
+
+def test_a_step_over_the_outer_part_is_one_zone_reaching_the_end():
+    """EI 12 % lower from 0.6 L to the right end (a beam of two sections): one section loss
+    whose zone ends on the end, inner edge within 2 % of the length and the ratio within 2σ,
+    its σ finite (on the end, centre and length move together: not a trade)."""
+    measured = reference_data(rigidity=lambda x: np.where(x > 0.6 * L, 0.88, 1.0))
+    diagnosis = diagnose(make_model(), measured, **NOISE)
+    assert diagnosis.verdict == "effect_found" and diagnosis.suggested == ["section_loss"]
+    outcome = update(make_model(), measured, ["section_loss"], **NOISE)
+    p, sigma = outcome.fit.effects[0].parameters, outcome.fit.sigma[0]
+    assert p["position"] + p["length"] / 2 == pytest.approx(L, abs=1e-9)
+    assert abs(p["position"] - p["length"] / 2 - 0.6 * L) <= 0.02 * L
+    assert abs(p["stiffness_ratio"] - 0.88) <= 2 * sigma["stiffness_ratio"]
+    assert np.isfinite(sigma["length"]) and sigma["length"] < 0.1 * p["length"]
+    assert not outcome.fit.unidentified
+    assert diagnose(outcome.model, measured, **NOISE).verdict == "consistent"
+
+
+def test_a_quadratic_taper_with_no_noise_given_is_a_profile_not_a_long_zone():
+    """A smooth taper, no noise stated: one long zone leaves residuals that may look white,
+    but a free profile explains significantly more, and it is the finding."""
+    s = interior(L, 17)
+    beam = ReferenceBeam(elements=600, supports=("clamped", "clamped"),
+                         rigidity=lambda x: 1.0 + 0.25 * (x / L) ** 2)
+    f, y = beam.measure(3, s, shape_noise=0.006, freq_noise=0.001, seed=24)
+    measured = make_measured(s, "w", f, y, "reference")
+    model = make_model(supports={"left": "clamped", "right": "clamped"})
+    diagnosis = diagnose(model, measured)
+    assert diagnosis.verdict == "effect_found"
+    assert diagnosis.suggested == ["stiffness_profile"]
 
 
 def loop_words(model, measured):

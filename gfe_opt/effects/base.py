@@ -312,6 +312,18 @@ class EffectType:
                 out[v.key].append(phys)
         return {k: out[k] for k in self.keys if k in out}
 
+    def tie(self, model, variables: list[Variable], z):
+        """Directions in which the fitted variables ``z`` can still move without changing
+        the effect in a way the variables do not show (a zone with an edge on an end):
+        ``(T, labels)``, T of shape (variables, directions), or None when every variable
+        moves freely (the default)."""
+        return None
+
+    def untie(self, model, variables: list[Variable], z):
+        """The same effect off a kink of the residual, where a fit can start (default: z
+        itself)."""
+        return z
+
     def to_variables(self, model, variables: list[Variable], params: dict) -> np.ndarray:
         out = []
         for v in variables:

@@ -19,6 +19,12 @@ def zone(centre: float, length: float, ratio: float):
     return f
 
 
+#: how far past an end (fraction of the length) a zone with an edge on that end starts a fit:
+#: any distance does (the zone on the structure is the same); one start grid step of the
+#: zone's length
+PAST_END = 0.05
+
+
 class SectionLoss(EffectType):
     name = "section_loss"
     physics = "EI and ρA multiplied by stiffness_ratio and mass_ratio over a zone"
@@ -47,8 +53,10 @@ class SectionLoss(EffectType):
         build.scale_mass(zone(c, ell, params["mass_ratio"]), breakpoints=edges, support=edges)
 
     def variables(self, model, fixed):
+        # a zone may span any part of the structure, up to an end (a step in the section
+        # over the outer half): no bound below the structure's length
         return [position_variable(),
-                Variable("length", 0.004, 0.3, (0.05,), scale=lambda m: m.length),
+                Variable("length", 0.004, 1.0, (0.05,), scale=lambda m: m.length),
                 # softer and stiffer alike (1/0.7): a start on one side only never found a
                 # stiffer zone, and which side a valley of frequencies alone ends on then
                 # hinged on rounding
@@ -56,6 +64,68 @@ class SectionLoss(EffectType):
                 # lighter and heavier alike: corrosion (EI and ρA × 0.7) is no better than
                 # nothing with ρA held at 1, so a start at 1 alone never found it
                 Variable("mass_ratio", 0.05, 3.0, (0.7, 1.0, 1 / 0.7))]
+
+    def to_physical(self, model, variables, z, fixed):
+        """The zone as it lies on the structure: a zone fitted past an end is the part of it
+        on the structure (its centre and length), so that every fit of one zone has one
+        set of parameters (past the end, centre and length trade exactly)."""
+        out = super().to_physical(model, variables, z, fixed)
+        if "position" in out and "length" in out:
+            L = model.length
+            a = max(out["position"] - out["length"] / 2.0, 0.0)
+            b = min(out["position"] + out["length"] / 2.0, L)
+            if b > a:
+                out["position"], out["length"] = (a + b) / 2.0, b - a
+        return out
+
+    def tie(self, model, variables, z):
+        """A zone that reaches an end has one edge there: its centre and length move
+        together as its inner edge moves (the outer edge stays on the end).  Returns the
+        columns that move the slot's variables (one for the inner edge, one per other
+        variable), their labels and the variables that are held, or None when the zone lies
+        inside the structure."""
+        keys = [v.key for v in variables]
+        if "position" not in keys or "length" not in keys:
+            return None
+        i, j = keys.index("position"), keys.index("length")
+        c, ell = z[i], z[j]              # fractions of the length
+        at_left, at_right = c - ell / 2 <= 1e-12, c + ell / 2 >= 1 - 1e-12
+        if not (at_left or at_right):
+            return None
+        columns, labels = [], []
+        if not (at_left and at_right):   # the whole structure: centre and length are held
+            edge = np.zeros(len(keys))
+            edge[i], edge[j] = 0.5, (-1.0 if at_right else 1.0)
+            columns.append(edge)
+            labels.append("inner edge")
+        for k, key in enumerate(keys):
+            if k not in (i, j):
+                unit = np.zeros(len(keys))
+                unit[k] = 1.0
+                columns.append(unit)
+                labels.append(key)
+        return np.array(columns).T.reshape(len(keys), len(columns)), labels
+
+    def untie(self, model, variables, z):
+        """A zone with an edge on an end, with that edge moved past the end by
+        :data:`PAST_END` of the length (the zone on the structure is the same; on the end
+        itself the residual has a kink: moving the edge inwards changes it, outwards not)."""
+        keys = [v.key for v in variables]
+        if "position" not in keys or "length" not in keys:
+            return z
+        z = np.array(z, dtype=float)
+        i, j = keys.index("position"), keys.index("length")
+        a, b = z[i] - z[j] / 2, z[i] + z[j] / 2
+        if (a <= 1e-12) == (b >= 1 - 1e-12):
+            return z    # inside, or the whole structure
+        if b >= 1 - 1e-12:
+            b = 1 + PAST_END
+        else:
+            a = -PAST_END
+        if b - a > 1.0:   # the length's bound: the zone cannot reach that far past the end
+            return z
+        z[i], z[j] = (a + b) / 2, b - a
+        return z
 
     def starts(self, model, hint):
         return [{}, *({"position": hint * model.length, "length": 0.05 * model.length,
