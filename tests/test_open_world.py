@@ -22,6 +22,7 @@ from .reference import ReferenceBeam, add_noise, christides_barr, interior, prod
 from .test_diagnosis import NOISE, loop, reference_data
 
 L = 0.575
+EI = ReferenceBeam().EI
 LOCAL_LOSSES = {"crack", "section_loss"}
 
 
@@ -90,6 +91,19 @@ def test_a_mid_span_spring_is_a_point_spring_not_a_foundation():
     assert [e.name for e in model.effects] == ["point_spring"] and last.verdict == "consistent"
     spring = model.effects[0].parameters
     assert abs(spring["position"] - L / 2) <= 0.015 and abs(spring["stiffness"] / 2e5 - 1) < 0.1
+
+
+def test_a_roller_partway_along_is_a_stiff_point_spring_at_its_place():
+    """An intermediate support that holds the beam still (a spring 10⁴ times stiffer than the
+    fifth mode's modal stiffness): the start grid spans flexible to rigid springs, so the
+    spring is found at its place, stiffer than the fifth mode's modal stiffness."""
+    k = 1e4 * (5 * np.pi) ** 4 * EI / L**3 / 2
+    measured = reference_data(point_springs=[(0.19, k)])
+    diagnosis = diagnose(make_model(), measured, **NOISE)
+    assert diagnosis.verdict == "effect_found" and diagnosis.suggested == ["point_spring"]
+    spring = diagnosis.best.parameters
+    assert abs(spring["position"] - 0.19) <= 0.02 * L
+    assert spring["stiffness"] > (5 * np.pi) ** 4 * EI / L**3 / 2
 
 
 def test_corrosion_is_a_local_loss_of_stiffness_and_mass():

@@ -40,7 +40,8 @@ class PointSpring(EffectType):
 
     def variables(self, model, fixed):
         return [position_variable(model),
-                Variable("stiffness", -3.0, 5.0, (0.0, 1.0, 2.0), log=True, scale=_scale)]
+                Variable("stiffness", -3.0, 5.0, (0.0, 1.0, 2.0, 3.0, 4.0), log=True,
+                         scale=_scale)]
 
     def starts(self, model, hint):
         return [{}, {"position": hint * model.length, "stiffness": 10.0 * _scale(model)}]
