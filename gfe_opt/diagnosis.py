@@ -28,8 +28,12 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
 5. The best **explains** the data when χ² is within the 99.9 % range of the stated noise;
    with no noise given, when the shape residuals are white (:func:`white`; frequency-only:
    within :data:`FREQ_NOISE_LIMIT` of the assumed noise).
-6. If it does not: a pair that explains (estimable) is suggested; else a free profile that
-   explains is the finding; else, when the profile is significantly better than the best,
+6. When the best does not bring χ² to the stated (or assumed) noise, the free profiles are
+   fitted as well, and a profile that explains significantly more than a best that
+   explains only by white residuals is the finding.
+   If the best does not explain: a pair that explains (estimable) is suggested; else a
+   free profile that explains is the finding; else, when the profile is significantly
+   better than the best,
    nothing named is a finding (``unexplained``); else the best is the finding and
    ``remaining`` says what is left after it.
 7. A finding that another converged end fits as well (not its mirror image on a symmetric
