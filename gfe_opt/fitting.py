@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
+from scipy.linalg import block_diag
 from scipy.special import chdtri
 
 from . import names
@@ -467,37 +468,32 @@ class FitProblem:
             i += k
         return out
 
-
     def canonical(self, z) -> np.ndarray:
         """``z`` with each slot's variables as its effect lies on the structure
         (:meth:`~gfe_opt.effects.base.EffectType.to_physical`); unchanged where they
         already are."""
-        z = np.array(z, dtype=float)
-        i = 0
-        for slot in self.slots:
-            k = len(slot.variables)
-            if k:
-                params = slot.effect.to_physical(self.base, slot.variables, z[i:i + k],
-                                                 slot.fixed)
-                again = slot.effect.to_variables(self.base, slot.variables, params)
-                if np.max(np.abs(again - z[i:i + k])) > 1e-12:
-                    z[i:i + k] = again
-            i += k
-        return z
-
+        def one(slot, zs):
+            again = slot.effect.to_variables(self.base, slot.variables, slot.effect.to_physical(
+                self.base, slot.variables, zs, slot.fixed))
+            return again if np.max(np.abs(again - zs)) > 1e-12 else zs
+        return self._per_slot(z, one)
 
     def untied(self, z) -> np.ndarray:
         """``z`` moved off the kinks of its effects (:meth:`EffectType.untie`: a zone with
         an edge on an end starts past it), the same structure; a fit started on a kink
         could not certify its stopping rule."""
+        return np.clip(self._per_slot(z, lambda slot, zs: slot.effect.untie(
+            self.base, slot.variables, zs)), self.lower, self.upper)
+
+    def _per_slot(self, z, fn) -> np.ndarray:
         z = np.array(z, dtype=float)
         i = 0
         for slot in self.slots:
             k = len(slot.variables)
             if k:
-                z[i:i + k] = slot.effect.untie(self.base, slot.variables, z[i:i + k])
+                z[i:i + k] = fn(slot, z[i:i + k])
             i += k
-        return np.clip(z, self.lower, self.upper)
+        return z
 
 
 def fit_problem(model: Model, measured: MeasuredModes, adding=(), *, noise: Noise, C=None,
@@ -959,7 +955,7 @@ def _ties(slots, base, z):
         k = len(slot.variables)
         tie = slot.effect.tie(base, slot.variables, z[i:i + k]) if k else None
         if tie is None:
-            blocks.append(np.eye(k))
+            blocks.append(np.eye(k).reshape(k, k))
             labels += [f"{slot.effect.name}.{v.label}" for v in slot.variables]
         else:
             any_tie = True
@@ -969,13 +965,7 @@ def _ties(slots, base, z):
         i += k
     if not any_tie:
         return None, None, None
-    rows = sum(b.shape[0] for b in blocks)
-    T = np.zeros((rows, sum(b.shape[1] for b in blocks)))
-    r = c = 0
-    for b in blocks:
-        T[r:r + b.shape[0], c:c + b.shape[1]] = b
-        r, c = r + b.shape[0], c + b.shape[1]
-    return T, labels, owner
+    return block_diag(*blocks), labels, owner
 
 
 def _tied_bounds(T, z, lower, upper):
