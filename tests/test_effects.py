@@ -206,3 +206,25 @@ def test_support_translation_needs_a_support_that_holds_the_translation():
         model.with_effects([Effect("support_translation", {"side": "left", "stiffness": 1e5})])
     with pytest.raises(GfeInputError, match="did you mean 'support_translation'"):
         parse_effect("support_translaton", model)
+
+
+def test_a_zone_fitted_past_an_end_is_the_part_on_the_structure():
+    """section_loss variables past the right end give the zone on the beam; the fit starts
+    past the end (off the kink) with the same zone; inside the beam nothing changes."""
+    model = make_model()
+    kind = effect_type("section_loss")
+    variables = kind.variables(model, {})
+    L = model.length
+    past = np.array([0.8, 0.6, 0.9, 1.0])          # zone 0.5 L .. 1.1 L
+    p = kind.to_physical(model, variables, past, {})
+    assert p["position"] == pytest.approx(0.75 * L) and p["length"] == pytest.approx(0.5 * L)
+    on_end = kind.to_variables(model, variables, p)
+    assert kind.tie(model, variables, on_end) is not None
+    moved = kind.untie(model, variables, on_end)
+    assert moved[0] + moved[1] / 2 > 1.0             # the outer edge past the end
+    again = kind.to_physical(model, variables, moved, {})
+    assert again["position"] == pytest.approx(p["position"], abs=1e-12 * L)
+    assert again["length"] == pytest.approx(p["length"], abs=1e-12 * L)
+    inside = np.array([0.4, 0.2, 0.9, 1.0])
+    assert kind.tie(model, variables, inside) is None
+    assert np.array_equal(kind.untie(model, variables, inside), inside)

@@ -61,6 +61,8 @@ def test_a_step_over_the_outer_part_is_one_zone_reaching_the_end():
     assert abs(p["position"] - p["length"] / 2 - 0.6 * L) <= 0.02 * L
     assert abs(p["stiffness_ratio"] - 0.88) <= 2 * sigma["stiffness_ratio"]
     assert np.isfinite(sigma["length"]) and sigma["length"] < 0.1 * p["length"]
+    # both from the inner edge a: centre (a + L)/2, length L - a
+    assert sigma["length"] == pytest.approx(2 * sigma["position"], rel=1e-9)
     assert not outcome.fit.unidentified
     assert diagnose(outcome.model, measured, **NOISE).verdict == "consistent"
 

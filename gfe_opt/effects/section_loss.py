@@ -19,6 +19,14 @@ def zone(centre: float, length: float, ratio: float):
     return f
 
 
+def _centre_length(keys):
+    """Indices of the fitted centre and length among the variables' keys, or None when
+    either is held."""
+    if "position" not in keys or "length" not in keys:
+        return None
+    return keys.index("position"), keys.index("length")
+
+
 #: how far past an end (fraction of the length) a zone with an edge on that end starts a fit:
 #: any distance does (the zone on the structure is the same); one start grid step of the
 #: zone's length
@@ -82,12 +90,13 @@ class SectionLoss(EffectType):
         """A zone that reaches an end has one edge there: its centre and length move
         together as its inner edge moves (the outer edge stays on the end).  Returns the
         columns that move the slot's variables (one for the inner edge, one per other
-        variable), their labels and the variables that are held, or None when the zone lies
-        inside the structure."""
+        variable) and their labels, or None when the zone lies inside the structure.  A zone
+        over the whole structure has no inner edge: its centre and length are held (σ
+        infinite: it is a change of E and ρA, not a zone)."""
         keys = [v.key for v in variables]
-        if "position" not in keys or "length" not in keys:
+        if _centre_length(keys) is None:
             return None
-        i, j = keys.index("position"), keys.index("length")
+        i, j = _centre_length(keys)
         c, ell = z[i], z[j]              # fractions of the length
         at_left, at_right = c - ell / 2 <= 1e-12, c + ell / 2 >= 1 - 1e-12
         if not (at_left or at_right):
@@ -110,11 +119,10 @@ class SectionLoss(EffectType):
         """A zone with an edge on an end, with that edge moved past the end by
         :data:`PAST_END` of the length (the zone on the structure is the same; on the end
         itself the residual has a kink: moving the edge inwards changes it, outwards not)."""
-        keys = [v.key for v in variables]
-        if "position" not in keys or "length" not in keys:
+        if _centre_length([v.key for v in variables]) is None:
             return z
         z = np.array(z, dtype=float)
-        i, j = keys.index("position"), keys.index("length")
+        i, j = _centre_length([v.key for v in variables])
         a, b = z[i] - z[j] / 2, z[i] + z[j] / 2
         if (a <= 1e-12) == (b >= 1 - 1e-12):
             return z    # inside, or the whole structure
