@@ -19,12 +19,15 @@ def zone(centre: float, length: float, ratio: float):
     return f
 
 
-def _centre_length(keys):
-    """Indices of the fitted centre and length among the variables' keys, or None when
-    either is held."""
+def _on_ends(variables, z):
+    """(i, j, at_left, at_right): the indices of the fitted centre and length among the
+    variables and whether the zone reaches each end (z in fractions of the length), or None
+    when either is held."""
+    keys = [v.key for v in variables]
     if "position" not in keys or "length" not in keys:
         return None
-    return keys.index("position"), keys.index("length")
+    i, j = keys.index("position"), keys.index("length")
+    return i, j, z[i] - z[j] / 2 <= 1e-12, z[i] + z[j] / 2 >= 1 - 1e-12
 
 
 #: how far past an end (fraction of the length) a zone with an edge on that end starts a fit:
@@ -93,14 +96,11 @@ class SectionLoss(EffectType):
         variable) and their labels, or None when the zone lies inside the structure.  A zone
         over the whole structure has no inner edge: its centre and length are held (σ
         infinite: it is a change of E and ρA, not a zone)."""
+        ends = _on_ends(variables, z)
+        if ends is None or not (ends[2] or ends[3]):
+            return None
+        i, j, at_left, at_right = ends
         keys = [v.key for v in variables]
-        if _centre_length(keys) is None:
-            return None
-        i, j = _centre_length(keys)
-        c, ell = z[i], z[j]              # fractions of the length
-        at_left, at_right = c - ell / 2 <= 1e-12, c + ell / 2 >= 1 - 1e-12
-        if not (at_left or at_right):
-            return None
         columns, labels = [], []
         if not (at_left and at_right):   # the whole structure: centre and length are held
             edge = np.zeros(len(keys))
@@ -119,14 +119,13 @@ class SectionLoss(EffectType):
         """A zone with an edge on an end, with that edge moved past the end by
         :data:`PAST_END` of the length (the zone on the structure is the same; on the end
         itself the residual has a kink: moving the edge inwards changes it, outwards not)."""
-        if _centre_length([v.key for v in variables]) is None:
-            return z
+        ends = _on_ends(variables, z)
+        if ends is None or ends[2] == ends[3]:
+            return z    # held, inside, or the whole structure
+        i, j, _, at_right = ends
         z = np.array(z, dtype=float)
-        i, j = _centre_length([v.key for v in variables])
         a, b = z[i] - z[j] / 2, z[i] + z[j] / 2
-        if (a <= 1e-12) == (b >= 1 - 1e-12):
-            return z    # inside, or the whole structure
-        if b >= 1 - 1e-12:
+        if at_right:
             b = 1 + PAST_END
         else:
             a = -PAST_END
