@@ -20,10 +20,11 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
 3. A candidate adding p parameters is **significant** when it lowers χ² by more than
    :math:`s^2\,χ^2_{p}(1-α')`, α = 10⁻³ divided by the number of candidates and, for an
    effect with a position, by the 2m + 1 places m modes can tell apart (look-elsewhere);
-   lies :data:`SIZE_SIGMAS` standard deviations from "no effect"; beats the best uniform
+   lies :data:`SIZE_SIGMAS` standard deviations from "no effect" (a stiffness on a bound
+   of its range: √(gain/s²), the likelihood ratio's distance); beats the best uniform
    change of E by the same margin (effects other than ``material``); and is **estimable**:
-   no parameter with σ above its value, no two with a correlation above 0.99
-   (:attr:`~gfe_opt.fitting.Fit.unidentified`).
+   no parameter with σ above its value, no two that trade (correlated above 0.99 and χ²
+   along their valley flatter than linearised, :attr:`~gfe_opt.fitting.Fit.unidentified`).
 4. Significant candidates are ranked by χ²/s² + p ln n (Bayesian information criterion).
 5. The best **explains** the data when χ² is within the 99.9 % range of the stated noise;
    with no noise given, when the shape residuals are white (:func:`white`; frequency-only:
@@ -33,7 +34,7 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
    explains only by white residuals is the finding.
    If the best does not explain: a pair that explains (estimable) is suggested; else a
    free profile that explains is the finding; else, when the profile is significantly
-   better than the best,
+   better than the best and no determined pair fitted is significantly better than it,
    nothing named is a finding (``unexplained``); else the best is the finding and
    ``remaining`` says what is left after it.
 7. A finding that another converged end fits as well (not its mirror image on a symmetric
@@ -446,8 +447,13 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
     base = model.with_effects([], check=False)
     for f in fits:
         kind = effect_type(f.name)
-        f.size_sigmas = kind.size_in_sigmas(base, f.parameters, f.uncertainty)
         f.gain = sel.reference_chi2 - f.misfit.chi2
+        f.size_sigmas = kind.size_in_sigmas(base, f.parameters, f.uncertainty)
+        if any(kind.parameter(k).null is not None for k in f.bound):
+            # a parameter on a bound of its range has no σ to measure a distance with: the
+            # distance from "no effect" is the likelihood ratio's, √(gain / floor) (what
+            # |value − null|/σ is for a linear model)
+            f.size_sigmas = float(np.sqrt(max(f.gain, 0.0) / sel.floor))
         f.threshold = sel.threshold(f)
         f.significant = (f.success and not f.failed and f.gain > f.threshold
                          and f.size_sigmas >= SIZE_SIGMAS and not f.unidentified)
@@ -565,8 +571,15 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         profile_wins = (best is not None and profile is not None and profile.significant
                         and sel.better(profile, best))
         if best is not None and (not explained or profile_wins):
-            first, pair = (_lookahead(model, measured, noise, best, fits, hint, explains, sel)
-                           if not explained else (best, None))
+            first, pair, tried = (
+                _lookahead(model, measured, noise, best, fits, hint, explains, sel)
+                if not explained else (best, None, []))
+            # a pair fitted (determined, significant over its first) that explains
+            # significantly more than the free profile shows the profile's win over the
+            # best alone is no reason to withhold the named effect (a notch and shear in a
+            # continuum).  A pair that merely ties with a profile far from the noise is
+            # one more way to absorb model error, not the structure's difference
+            rivalled = profile is not None and any(sel.better(p, profile) for p in tried)
             if pair is not None and profile is not None and profile.success \
                     and not profile.failed and sel.better(profile, pair):
                 pair = None   # a free profile explains significantly more than the pair
@@ -578,16 +591,20 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                 notes += equivalent_notes(pair, measured)
                 if profile is not None:
                     profile.significant = False  # named effects win where they explain
-            elif profile is not None and profile.significant and explains(profile):
+            elif profile is not None and profile.significant and explains(profile) \
+                    and not rivalled:
                 notes.append(f"{best.name} explains part of the difference; the "
                              f"{profile.name} explains it to the noise")
                 best.significant = False
-            elif profile is not None and profile.significant and sel.better(profile, best):
+            elif profile is not None and profile.significant and sel.better(profile, best) \
+                    and not rivalled:
                 # a free profile explains significantly more than every named effect and
                 # pair: no named finding; how the structure differs is the profile
                 partial = best
                 for f in fits:
                     f.significant = False
+            elif rivalled:
+                profile.significant = False  # a pair of named effects does as well
             # else: the best named effect is the finding, and what remains after it is said
             # (``remaining``): the next diagnosis works on it
         elif explained and profile is not None:
@@ -762,15 +779,18 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
                                         sel)
                        if f is not best and not sel.better(best, f)
                        and not getattr(effect_type(f.name), "fallback", False)]
+    tried = []
     for first_fit in firsts:
-        pair = _pairs_with(model, measured, noise, first_fit, fits, hint, explains, sel)
+        pair, pairs = _pairs_with(model, measured, noise, first_fit, fits, hint, explains, sel)
+        tried += [p for p in pairs if sel.better(p, first_fit)]
         if pair is not None:
-            return first_fit, pair
-    return best, None
+            return first_fit, pair, tried
+    return best, None, tried
 
 
 def _pairs_with(model, measured, noise, best, fits, hint, explains, sel):
-    """The best pair of ``best`` and one more effect that ``explains`` the data, or None."""
+    """The best pair of ``best`` and one more effect that ``explains`` the data, or None;
+    and every determined pair fitted."""
     # a candidate whose own fit did not converge is still tried as the second effect
     others = [f for f in (fits[i] for i in ranked([f.misfit.chi2 for f in fits]))
               if f is not best and (not f.failed or not f.success) and f.name != best.name
@@ -781,9 +801,9 @@ def _pairs_with(model, measured, noise, best, fits, hint, explains, sel):
     jobs = [("candidate", (model, measured, name, noise, hint, None, (first,),
                            [alone[name]] if name in alone else []))
             for name in seconds]
-    pairs = [p for p in _run_jobs(jobs, None, seconds)
-             if p.success and not p.unidentified and explains(p)]
-    return _rank(pairs, sel)[0] if pairs else None
+    pairs = [p for p in _run_jobs(jobs, None, seconds) if p.success and not p.unidentified]
+    explaining = [p for p in pairs if explains(p)]
+    return (_rank(explaining, sel)[0] if explaining else None), pairs
 
 
 def _generic_update(model, measured, noise):

@@ -348,6 +348,9 @@ class Fit:
     mirror_position: float | None = None   # fits as well at x -> L - x (set by diagnosis)
     equivalent: list = field(default_factory=list)  # other effect sets that fit as well
     unidentified: list = field(default_factory=list)  # parameters these data do not estimate
+    #: per effect, parameters that ended on a bound of their range: {key: "at least" |
+    #: "at most"} (the data tell one side only)
+    bounds: tuple = ()
 
     @property
     def effect(self) -> str:
@@ -361,12 +364,21 @@ class Fit:
     def uncertainty(self) -> dict:
         return self.sigma[self.added] if self.added is not None else {}
 
+    @property
+    def bound(self) -> dict:
+        """The added effect's parameters on a bound of their range (one-sided)."""
+        return self.bound_of(self.added) if self.added is not None else {}
+
+    def bound_of(self, i: int) -> dict:
+        """Effect i's parameters on a bound of their range."""
+        return self.bounds[i] if i < len(self.bounds) else {}
+
     def describe(self) -> str:
         """``crack: position = 0.190 ± 0.001 m, depth_ratio = 0.50 ± 0.01``."""
         if self.added is None:
             return "present effects re-estimated"
-        return f"{self.name}: " + effect_type(self.name).describe(self.parameters,
-                                                                 self.uncertainty)
+        return f"{self.name}: " + effect_type(self.name).describe(
+            self.parameters, self.uncertainty, self.bound)
 
     def to_json(self) -> dict:
         out = {"effect": self.name, "parameters": jsonable(self.parameters),
@@ -374,7 +386,8 @@ class Fit:
                "significant": self.significant, "mirror_position": self.mirror_position,
                "equivalent": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
                                for e in effects] for effects in self.equivalent],
-               "not_estimable": list(self.unidentified)}
+               "not_estimable": list(self.unidentified),
+               "bounds": {k: v.replace(" ", "_") for k, v in self.bound.items()}}
         return out
 
 
@@ -586,14 +599,16 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     effects = effects_of(z)
     fitted = base.with_effects(effects, check=False)
     fit_misfit = misfit(fitted, measured, noise, C)
-    sigma, unidentified = _uncertainty(residual, z, slots, base, fit_misfit, lower, upper)
+    saturated = _saturated(slots, z, lower, upper)
+    sigma, unidentified = _uncertainty(residual, z, slots, base, fit_misfit, lower, upper,
+                                       saturated)
     added = [i for i, s in enumerate(slots) if s.added]
     return Fit(name=name or (slots[added[0]].effect.name if added else "baseline"),
                effects=tuple(effects), sigma=tuple(sigma), added=added[0] if added else None,
                model=fitted, misfit=fit_misfit, n_params=z.size, status=status,
                success=success and np.isfinite(fit_misfit.chi2), evaluations=residual.count,
                equivalent=[tuple(effects_of(e)) for e in equivalent],
-               unidentified=unidentified)
+               unidentified=unidentified, bounds=tuple(saturated))
 
 
 #: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
@@ -872,16 +887,45 @@ def _secant(S, s, J_old, J_new, r_new, g_old):
 #: its correlation with another fitted parameter exceeds this (they trade: only a
 #: combination is determined)
 IDENTIFIABLE_CORRELATION = 0.99
+#: ... and, checked on the fit itself, their χ² two linearised σ along the trade rises by
+#: less than one unit of the noise floor (a quadratic valley: four): the printed σ then
+#: understates the trade more than twice over.  Where the valley is as steep as linearised,
+#: the σ already covers the trade and a correlation alone does not undetermine anything (a
+#: crack near a clamp: position and depth correlated +0.999, σ 0.3 % of the length)
+TRADE_STEP_SIGMAS = 2.0
 
 
-def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper):
+def _saturated(slots, z, lower, upper) -> list:
+    """Per slot, its log-scaled variables (stiffnesses over decades) that end on a bound of
+    their range: ``{key: "at least"}`` on the upper one, ``"at most"`` on the lower.  The
+    data then tell only one side (a roller read as a spring: rigid as far as the modes
+    tell); a σ from the curvature there means nothing."""
+    out, i = [], 0
+    for slot in slots:
+        marks = {}
+        for v in slot.variables:
+            span = 1e-6 * (upper[i] - lower[i])
+            if v.log and v.index is None and z[i] >= upper[i] - span:
+                marks[v.key] = "at least"
+            elif v.log and v.index is None and z[i] <= lower[i] + span:
+                marks[v.key] = "at most"
+            i += 1
+        out.append(marks)
+    return out
+
+
+def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=None):
     """Standard deviations of every slot's physical parameters (Gauss–Newton), and the
     parameters the data do not estimate (sentences: σ above the value, or a correlation
-    above :data:`IDENTIFIABLE_CORRELATION` with another parameter)."""
+    above :data:`IDENTIFIABLE_CORRELATION` with another parameter).  ``saturated``
+    (:func:`_saturated`) variables are held: σ infinite, the others' σ with them fixed."""
     n = z.size
     out = [{} for _ in slots]
     if n == 0 or not np.isfinite(fit_misfit.chi2):
         return out, []
+    held = np.array([v.key in marks for marks, slot in zip(saturated or [{}] * len(slots),
+                                                             slots) for v in slot.variables],
+                    dtype=bool)
     r0 = residual(z)
     T, tied_names, tied_owner = _ties(slots, base, z)
     if T is None:
@@ -896,6 +940,9 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper):
         J = _difference_jacobian(lambda y: residual(z + T @ y), np.zeros(T.shape[1]), r0,
                                  lo, hi, step=1e-4)
     m = J.shape[1]
+    if held.any():   # a held variable's direction(s) carry nothing
+        J = J.copy()
+        J[:, (held if T is None else (np.abs(T[held]) > 0).any(axis=0))] = 0.0
     A = J.T @ J
     ridge = 1e-12 * max(float(np.max(np.diag(A))), 1e-300)
     s2 = max(1.0, fit_misfit.chi2 / max(fit_misfit.n_residuals - n, 1))
@@ -928,7 +975,8 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper):
                      else f"{slot.effect.name}.{v.key}[{v.index}]")
             names.append(label)
             rule = slot.effect.parameter(v.key).rule if v.index is None else "ratios"
-            if slot.added and rule in ("positive", "fraction") and not value <= abs(phys):
+            if slot.added and rule in ("positive", "fraction") and not value <= abs(phys) \
+                    and not held[i]:
                 unidentified.append(f"{label}: σ {value:.3g} exceeds its value {phys:.3g}")
             i += 1
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -937,10 +985,27 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper):
     if T is not None:   # correlations of the directions the effects move in
         names, owner = tied_names, tied_owner
     added = {i for i, k in enumerate(owner) if slots[k].added} or set(range(m))
+    def trades(a, b) -> bool:
+        """χ² along the (a, b) valley, the other parameters following it (linearised),
+        rises by less than one floor unit at TRADE_STEP_SIGMAS σ."""
+        sub = cov[np.ix_([a, b], [a, b])]
+        w, V = np.linalg.eigh(sub)
+        if not np.all(np.isfinite(cov[:, [a, b]])) or w[-1] <= 0.0:
+            return True
+        d = cov[:, [a, b]] @ np.linalg.solve(sub, V[:, -1] * np.sqrt(w[-1]))
+        chi0, rises = float(r0 @ r0), []
+        for sign in (1.0, -1.0):
+            step = sign * TRADE_STEP_SIGMAS * (d if T is None else T @ d)
+            zz = z + step
+            if np.all(zz >= lower) and np.all(zz <= upper):
+                rr = residual(zz)
+                rises.append(float(rr @ rr) - chi0)
+        return not rises or min(rises) < s2
+
     for a in range(m):
         for b in range(a + 1, m):
             if (a in added or b in added) and np.isfinite(corr[a, b]) \
-                    and abs(corr[a, b]) > IDENTIFIABLE_CORRELATION:
+                    and abs(corr[a, b]) > IDENTIFIABLE_CORRELATION and trades(a, b):
                 unidentified.append(f"{names[a]} and {names[b]} trade against each other "
                                     f"(correlation {corr[a, b]:+.3f})")
     return out, unidentified

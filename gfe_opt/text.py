@@ -121,8 +121,9 @@ def format_diagnosis(result, model) -> str:
             held = len(model.effects)
             lines.append("  together, fitted with each other (what update --add gives; the "
                          "figures show these):")
-            lines += [f"    {e.name}: {effect_type(e.name).describe(e.parameters, s)}"
-                      for e, s in zip(pair.effects[held:], pair.sigma[held:])]
+            lines += [f"    {e.name}: "
+                      f"{effect_type(e.name).describe(e.parameters, s, pair.bound_of(i))}"
+                      for i, (e, s) in enumerate(zip(pair.effects, pair.sigma)) if i >= held]
             lines.append(f"  together: frequency error {now.freq_error_rms_pct:.3f} % -> "
                          f"{pair.misfit.freq_error_rms_pct:.3f} %, χ²/n "
                          f"{_ratio(now.chi2_per_residual)} -> "
@@ -159,7 +160,8 @@ def format_update(outcome) -> str:
     lines = [misfit_line(outcome.before, "before")]
     for i, (e, sigma) in enumerate(zip(outcome.fit.effects, outcome.fit.sigma)):
         mark = "added" if i in outcome.added else "re-estimated"
-        lines.append(f"  {e.name} ({mark}): {effect_type(e.name).describe(e.parameters, sigma)}")
+        lines.append(f"  {e.name} ({mark}): "
+                     f"{effect_type(e.name).describe(e.parameters, sigma, outcome.fit.bound_of(i))}")
     lines.append(misfit_line(outcome.after, "after"))
     lines += [f"note: {n}" for n in outcome.notes]
     return "\n".join(lines)

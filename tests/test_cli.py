@@ -122,7 +122,8 @@ def test_diagnose_json_contract(files, capsys):
     for entry in data["effects"]:
         assert set(entry) == {"effect", "parameters", "uncertainty", "freq_error_rms_pct",
                               "mac_mean", "chi2_per_residual", "significant",
-                              "mirror_position", "equivalent", "not_estimable"}
+                              "mirror_position", "equivalent", "not_estimable", "bounds"}
+        assert all(v in ("at_least", "at_most") for v in entry["bounds"].values())
         assert set(entry["uncertainty"]) <= set(entry["parameters"])
     first = data["effects"][0]
     assert first["significant"] and abs(first["parameters"]["position"] - 0.4) < 0.015

@@ -89,3 +89,52 @@ def test_mode_sign_follows_the_first_of_equal_peaks():
         shaped[30] *= 1 + bump
         row = peak_rows(shaped)[0]
         assert row == 10 and shaped[row, 0] > 0
+
+
+def _two_parameter_slot():
+    """A stand-in for one added effect with two 'positive' parameters a and b."""
+    from types import SimpleNamespace
+
+    from gfe_opt.effects.base import Parameter, Variable
+
+    params = {k: Parameter(k, "-", "positive", k) for k in ("a", "b")}
+    effect = SimpleNamespace(name="toy", parameter=params.__getitem__,
+                             tie=lambda model, variables, z: None)
+    variables = [Variable(k, 0.01, 10.0, (1.0,)) for k in ("a", "b")]
+    return [SimpleNamespace(effect=effect, variables=variables, added=True)]
+
+
+def _sigma_of(residual, z):
+    from types import SimpleNamespace
+
+    from gfe_opt.fitting import _uncertainty
+
+    r = residual(z)
+    misfit = SimpleNamespace(chi2=float(r @ r), n_residuals=r.size)
+    return _uncertainty(residual, z, _two_parameter_slot(), None, misfit,
+                        np.full(2, 0.01), np.full(2, 10.0))
+
+
+def test_a_correlation_alone_does_not_make_parameters_inestimable():
+    """Two parameters correlated beyond −0.999 (one rises as the other falls) whose χ²
+    valley is as steep as linearised (a linear problem): the σ already covers the trade and
+    both are determined to 1 %."""
+    rng = np.random.default_rng(3)
+    A = np.column_stack([np.ones(40), np.ones(40) + 0.03 * rng.standard_normal(40)]) * 1000
+    b = A @ np.array([1.0, 2.0])
+    sigma, unidentified = _sigma_of(lambda z: A @ z - b, np.array([1.0, 2.0]))
+    cov = np.linalg.inv(A.T @ A)
+    assert cov[0, 1] / np.sqrt(cov[0, 0] * cov[1, 1]) < -0.999   # correlated
+    assert sigma[0]["a"] < 0.01 and sigma[0]["b"] < 0.02
+    assert unidentified == []
+
+
+def test_a_curved_valley_is_a_trade_the_linear_sigma_misses():
+    """Only the product a·b is measured well (a hyperbolic valley, slightly tilted): the
+    correlation is above 0.99 and χ² two linearised σ along the valley rises far less than
+    a quadratic's 4 — the parameters trade, and the output says so."""
+    def residual(z):
+        return np.array([1e3 * (z[0] * z[1] - 2.0), 0.05 * (z[0] - 1.0), 0.05 * (z[1] - 2.0)])
+
+    _, unidentified = _sigma_of(residual, np.array([1.0, 2.0]))
+    assert any("trade against each other" in u for u in unidentified), unidentified

@@ -351,11 +351,16 @@ class EffectType:
         return best
 
     # -- what users see ---------------------------------------------------------------
-    def describe(self, params: dict, sigma: dict | None = None) -> str:
-        """``position = 0.190 ± 0.001 m, depth_ratio = 0.50 ± 0.01``."""
+    def describe(self, params: dict, sigma: dict | None = None,
+                 bounds: dict | None = None) -> str:
+        """``position = 0.190 ± 0.001 m, depth_ratio = 0.50 ± 0.01``; a parameter on a bound
+        of its range (``bounds``: "at least" / "at most") as ``stiffness ≥ 1e9 N/m``."""
         parts = []
         for p in self.parameters:
             if p.name not in params:
+                continue
+            if p.name in (bounds or {}):
+                parts.append(format_bound(p, params[p.name], bounds[p.name]))
                 continue
             parts.append(format_value(p, params[p.name], (sigma or {}).get(p.name)))
         return ", ".join(parts)
@@ -376,6 +381,14 @@ class EffectType:
         """Extra figures when this effect is found (name -> matplotlib figure); ``band`` is
         the generic update's :class:`~gfe_opt.realisation.ProfileBand` or None."""
         return {}
+
+
+def format_bound(p: Parameter, value, side: str) -> str:
+    """A parameter on a bound of its range: ``stiffness ≥ 1e+09 N/m (one-sided: ...)``."""
+    unit = f" {p.unit}" if p.unit and p.unit != "-" else ""
+    sign = "≥" if side == "at least" else "≤"
+    return (f"{p.name} {sign} {value:.4g}{unit} (the end of its range: the data tell only "
+            f"that it is {side} this)")
 
 
 def format_value(p: Parameter, value, sigma=None) -> str:
