@@ -1100,14 +1100,15 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
                                 where / model.length if where is not None else hint,
                                 given=e.parameters, extra=tuple(starts))
         starts.append(Effect(e.name, {**single.parameters, **e.parameters}))
-    fit = fit_effects(model, measured, starts, noise=noise, C=C,
-                      name=" + ".join(e.name for e in effects))
-    if not fit.success and single is not None and single.success:
+    if single is not None and single.success:
         # the last candidate's own fit is already the fit of every effect (the others
-        # re-estimated with it): a refit from its end can fail where it converged (an end
-        # a hair from a kink, a zone's edge near an end), and it is still the answer
+        # re-estimated with it, from each of its starts): a refit from its end only did
+        # the work again (and could fail where it converged: an end a hair from a kink)
         fit = single
         fit.name = " + ".join(e.name for e in effects)
+    else:
+        fit = fit_effects(model, measured, starts, noise=noise, C=C,
+                          name=" + ".join(e.name for e in effects))
     if not fit.success:
         raise GfeSolverError(f"the fit of the effects did not converge (last IPOPT status "
                              f"{fit.status})")
