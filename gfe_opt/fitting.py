@@ -985,6 +985,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     if T is not None:   # correlations of the directions the effects move in
         names, owner = tied_names, tied_owner
     added = {i for i, k in enumerate(owner) if slots[k].added} or set(range(m))
+
     def trades(a, b) -> bool:
         """χ² along the (a, b) valley, the other parameters following it (linearised),
         rises by less than one floor unit at TRADE_STEP_SIGMAS σ."""

@@ -167,7 +167,8 @@ def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None,
                      findings=()):
     """The structure as a bar on ``ax`` (x in m): its supports, the sensors, where the model
     fails (``places``: (x, share of the largest residual)) and ``findings``: (effect type,
-    model, parameters, σ) each drawn by the effect's own ``mark``."""
+    model, parameters, σ[, parameters on a bound]) each drawn by the effect's own
+    ``mark``."""
     ax.plot([0, length], [0, 0], lw=6, color="0.4", solid_capstyle="butt")
     if sensors is not None and len(sensors):
         ax.plot(sensors, np.zeros_like(np.asarray(sensors, float)), "|", color="white",
@@ -182,8 +183,8 @@ def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None,
             ax.annotate(f"model fails most: x = {x:.3f} m", (x, -0.35),
                         textcoords="offset points", xytext=(0, -12), ha="center", fontsize=7,
                         color="tab:purple")
-    for k, (effect, model, params, sigma) in enumerate(findings):  # a pair on two levels
-        effect.mark(ax, model, params, sigma, 0.35 + 0.5 * k)
+    for k, (effect, model, params, sigma, *bounds) in enumerate(findings):  # a pair: 2 levels
+        effect.mark(ax, model, params, sigma, 0.35 + 0.5 * k, *bounds)
     ax.set_yticks([])
     ax.set_ylim(-1.2, 1.2)
     ax.set_xlim(-0.04 * length, 1.04 * length)

@@ -28,14 +28,15 @@ def compare_figures(result, model) -> dict:
 
 
 def findings(diagnosis, model) -> list:
-    """The effects a diagnosis found, as (effect type, model, parameters, σ) for the
-    structure sketch: the suggested pair when there is one, else the effect found."""
+    """The effects a diagnosis found, as (effect type, model, parameters, σ, parameters on a
+    bound) for the structure sketch: the suggested pair when there is one, else the effect
+    found."""
     fit = diagnosis.together or diagnosis.best
     if fit is None:
         return []
     held = len(model.effects)
-    return [(effect_type(e.name), model, e.parameters, s)
-            for e, s in zip(fit.effects[held:], fit.sigma[held:])]
+    return [(effect_type(e.name), model, e.parameters, s, fit.bound_of(i))
+            for i, (e, s) in enumerate(zip(fit.effects, fit.sigma)) if i >= held]
 
 
 def verdict_title(diagnosis) -> str:

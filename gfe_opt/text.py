@@ -160,8 +160,8 @@ def format_update(outcome) -> str:
     lines = [misfit_line(outcome.before, "before")]
     for i, (e, sigma) in enumerate(zip(outcome.fit.effects, outcome.fit.sigma)):
         mark = "added" if i in outcome.added else "re-estimated"
-        lines.append(f"  {e.name} ({mark}): "
-                     f"{effect_type(e.name).describe(e.parameters, sigma, outcome.fit.bound_of(i))}")
+        words = effect_type(e.name).describe(e.parameters, sigma, outcome.fit.bound_of(i))
+        lines.append(f"  {e.name} ({mark}): {words}")
     lines.append(misfit_line(outcome.after, "after"))
     lines += [f"note: {n}" for n in outcome.notes]
     return "\n".join(lines)

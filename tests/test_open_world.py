@@ -111,6 +111,19 @@ def test_a_roller_partway_along_is_a_stiff_point_spring_at_its_place():
     assert diagnosis.best.bound == {"stiffness": "at least"}
     assert "stiffness ≥ " in diagnosis.best.describe()
     assert diagnosis.best.to_json()["bounds"] == {"stiffness": "at_least"}
+    # ... and on the structure sketch of the figures and the report
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from gfe_opt.plots import structure_sketch
+    from gfe_opt.report import findings
+
+    fig, ax = plt.subplots()
+    structure_sketch(ax, L, findings=findings(diagnosis, make_model()))
+    assert any(t.get_text().startswith("≥ ") for t in ax.texts)
+    plt.close(fig)
 
 
 def test_corrosion_is_a_local_loss_of_stiffness_and_mass():

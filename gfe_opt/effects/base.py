@@ -365,11 +365,13 @@ class EffectType:
             parts.append(format_value(p, params[p.name], (sigma or {}).get(p.name)))
         return ", ".join(parts)
 
-    def mark(self, ax, model, params: dict, sigma: dict | None, y: float) -> None:
-        """Draw the effect on the structure sketch (a matplotlib axis, x in m) at height y;
+    def mark(self, ax, model, params: dict, sigma: dict | None, y: float,
+             bounds: dict | None = None) -> None:
+        """Draw the effect on the structure sketch (a matplotlib axis, x in m) at height y
+        (``bounds``: parameters on a bound of their range, as :meth:`describe` takes them);
         default, for effects of the whole structure: the name and the fitted values, from
         the left end."""
-        ax.annotate(f"{self.name}: {self.describe(params, sigma)}", (0.0, y),
+        ax.annotate(f"{self.name}: {self.describe(params, sigma, bounds)}", (0.0, y),
                     textcoords="offset points", xytext=(0, 8), ha="left", fontsize=7,
                     color="tab:red")
 

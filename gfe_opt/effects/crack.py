@@ -64,7 +64,7 @@ class Crack(EffectType):
             return {}
         return {"disturbance.png": _disturbance_figure(model, params, band)}
 
-    def mark(self, ax, model, params, sigma, y):
+    def mark(self, ax, model, params, sigma, y, bounds=None):
         x = params["position"]
         ax.plot([x], [y], marker="v", color="tab:red", ms=9, zorder=5)
         s = (sigma or {}).get("position")

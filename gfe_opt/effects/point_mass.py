@@ -39,7 +39,7 @@ class PointMass(EffectType):
         return [{}, {"position": hint * model.length,
                      "mass": 0.2 * model.rho * model.area * model.length}]
 
-    def mark(self, ax, model, params, sigma, y):
+    def mark(self, ax, model, params, sigma, y, bounds=None):
         x = params["position"]
         ax.plot([x], [y], marker="s", color="tab:purple", ms=8, zorder=5)
         ax.annotate(f"{1000 * params['mass']:.3g} g", (x, y), textcoords="offset points",

@@ -46,10 +46,12 @@ class PointSpring(EffectType):
     def starts(self, model, hint):
         return [{}, {"position": hint * model.length, "stiffness": 10.0 * _scale(model)}]
 
-    def mark(self, ax, model, params, sigma, y):
+    def mark(self, ax, model, params, sigma, y, bounds=None):
         x = params["position"]
         ax.plot([x], [y], marker="$\\wedge\\!\\!\\vee$", color="tab:green", ms=12, zorder=5)
-        ax.annotate(f"{params['stiffness']:.3g} N/m", (x, y), textcoords="offset points",
+        at_least = "≥ " if (bounds or {}).get("stiffness") == "at least" else ""
+        ax.annotate(f"{at_least}{params['stiffness']:.3g} N/m", (x, y),
+                    textcoords="offset points",
                     xytext=(0, 9), ha="center", fontsize=7, color="tab:green")
 
 

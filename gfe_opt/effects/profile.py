@@ -57,5 +57,5 @@ class ProfileEffect(EffectType):
     def position(self, params):
         return None
 
-    def mark(self, ax, model, params, sigma, y):
+    def mark(self, ax, model, params, sigma, y, bounds=None):
         ax.plot(params["x"], [y] * len(params["x"]), "|", color="tab:brown", ms=8)

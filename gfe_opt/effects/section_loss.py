@@ -138,7 +138,7 @@ class SectionLoss(EffectType):
         return [{}, *({"position": hint * model.length, "length": 0.05 * model.length,
                        "stiffness_ratio": ratio, "mass_ratio": 1.0} for ratio in (0.7, 1 / 0.7))]
 
-    def mark(self, ax, model, params, sigma, y):
+    def mark(self, ax, model, params, sigma, y, bounds=None):
         c, ell = params["position"], params["length"]
         ax.plot([c - ell / 2, c + ell / 2], [0.0, 0.0], lw=9, color="tab:orange",
                 solid_capstyle="butt", zorder=4)  # the zone on the beam

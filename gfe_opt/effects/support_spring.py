@@ -51,7 +51,7 @@ class SupportSpring(EffectType):
     def position(self, params):
         return None
 
-    def mark(self, ax, model, params, sigma, y):
+    def mark(self, ax, model, params, sigma, y, bounds=None):
         sides = ("left", "right") if params["side"] == "both" else (params["side"],)
         for side in sides:
             x = 0.0 if side == "left" else model.length

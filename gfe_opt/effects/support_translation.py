@@ -61,7 +61,7 @@ class SupportTranslation(EffectType):
     def position(self, params):
         return None
 
-    def mark(self, ax, model, params, sigma, y):
+    def mark(self, ax, model, params, sigma, y, bounds=None):
         for side in effect_sides(params):
             x = 0.0 if side == "left" else model.length
             ax.plot([x], [y], marker="$\\updownarrow$", color="tab:red", ms=12)
