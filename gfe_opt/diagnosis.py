@@ -227,9 +227,8 @@ class Diagnosis:
                 "indistinguishable": [f.name for f in self.alike],
                 "suggested": list(self.suggested),
                 "together": None if self.together is None else {
-                    "effects": [{"effect": e.name, "parameters": jsonable(e.parameters),
-                                 "uncertainty": jsonable(s)}
-                                for e, s in zip(self.together.effects, self.together.sigma)],
+                    "effects": [self.together.effect_json(i)
+                                for i in range(len(self.together.effects))],
                     **self.together.misfit.summary()},
                 "remaining": None if self.remaining is None else jsonable(self.remaining),
                 "offered": list(self.offered),
@@ -1053,9 +1052,7 @@ class UpdateOutcome:
     def to_json(self) -> dict:
         """The ``update --json`` contract."""
         return {"before": self.before.summary(), "after": self.after.summary(),
-                "effects": [{"effect": e.name, "parameters": jsonable(e.parameters),
-                             "uncertainty": jsonable(s)}
-                            for e, s in zip(self.fit.effects, self.fit.sigma)]}
+                "effects": [self.fit.effect_json(i) for i in range(len(self.fit.effects))]}
 
 
 def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,

@@ -380,6 +380,13 @@ class Fit:
         return f"{self.name}: " + effect_type(self.name).describe(
             self.parameters, self.uncertainty, self.bound)
 
+    def effect_json(self, i: int) -> dict:
+        """Effect i of the fit: name, parameters, σ and the parameters on a bound."""
+        e = self.effects[i]
+        return {"effect": e.name, "parameters": jsonable(e.parameters),
+                "uncertainty": jsonable(self.sigma[i]),
+                "bounds": {k: v.replace(" ", "_") for k, v in self.bound_of(i).items()}}
+
     def to_json(self) -> dict:
         out = {"effect": self.name, "parameters": jsonable(self.parameters),
                "uncertainty": jsonable(self.uncertainty), **self.misfit.summary(),

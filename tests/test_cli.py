@@ -141,7 +141,7 @@ def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_p
     assert set(data["before"]) == set(data["after"]) == {"freq_error_rms_pct", "mac_mean",
                                                          "chi2_per_residual"}
     assert data["after"]["chi2_per_residual"] < 2.0 < data["before"]["chi2_per_residual"]
-    assert set(data["effects"][0]) == {"effect", "parameters", "uncertainty"}
+    assert set(data["effects"][0]) == {"effect", "parameters", "uncertainty", "bounds"}
     assert data["after"]["freq_error_rms_pct"] < 0.1 * data["before"]["freq_error_rms_pct"]
     assert data["effects"][0]["effect"] == "crack"
     assert [e.name for e in load_model(out).effects] == ["crack"]

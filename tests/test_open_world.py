@@ -124,6 +124,10 @@ def test_a_roller_partway_along_is_a_stiff_point_spring_at_its_place():
     structure_sketch(ax, L, findings=findings(diagnosis, make_model()))
     assert any(t.get_text().startswith("≥ ") for t in ax.texts)
     plt.close(fig)
+    outcome = update(make_model(), measured, ["point_spring"], **NOISE)
+    entry = outcome.to_json()["effects"][0]
+    assert entry["bounds"] == {"stiffness": "at_least"} and entry["uncertainty"]["stiffness"] \
+        is None
 
 
 def test_corrosion_is_a_local_loss_of_stiffness_and_mass():
