@@ -254,7 +254,8 @@ def check_enough_modes(measured: MeasuredModes, effects) -> None:
     """A fit needs more measured values than fitted parameters (frequency-only: more
     frequencies).  Whether the data *determine* the parameters is asked of each fit instead
     (:attr:`~gfe_opt.fitting.Fit.unidentified`: σ above the value, or two parameters that
-    trade with a correlation above 0.99), not decided by a budget of values per parameter."""
+    trade: a correlation above 0.99 along a valley flatter than linearised), not decided by
+    a budget of values per parameter."""
     total = sum(fitted_parameter_count(e.name) for e in effects)
     values = measured.n_modes if measured.frequency_only else measured.n_values
     if values <= total:
