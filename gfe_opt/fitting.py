@@ -388,14 +388,14 @@ class Fit:
                 "bounds": {k: v.replace(" ", "_") for k, v in self.bound_of(i).items()}}
 
     def to_json(self) -> dict:
-        out = {"effect": self.name, "parameters": jsonable(self.parameters),
-               "uncertainty": jsonable(self.uncertainty), **self.misfit.summary(),
-               "significant": self.significant, "mirror_position": self.mirror_position,
-               "equivalent": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
-                               for e in effects] for effects in self.equivalent],
-               "not_estimable": list(self.unidentified),
-               "bounds": {k: v.replace(" ", "_") for k, v in self.bound.items()}}
-        return out
+        added = (self.effect_json(self.added) if self.added is not None
+                 else {"parameters": {}, "uncertainty": {}, "bounds": {}})
+        return {"effect": self.name, "parameters": added["parameters"],
+                "uncertainty": added["uncertainty"], **self.misfit.summary(),
+                "significant": self.significant, "mirror_position": self.mirror_position,
+                "equivalent": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
+                                for e in effects] for effects in self.equivalent],
+                "not_estimable": list(self.unidentified), "bounds": added["bounds"]}
 
 
 def jsonable(params: dict) -> dict:
