@@ -116,6 +116,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="effect instance to add, e.g. crack or crack:position=0.2 "
                         "(repeatable; local effects may be added several times; known: "
                         f"{', '.join(EFFECTS)})")
+    u.add_argument("--drop", action="append", default=[], metavar="EFFECT",
+                   help="take a present effect out first: its index in the model's effects "
+                        "(from 0, as diagnose's 'replace') or its name (repeatable)")
     u.add_argument("--out", help="write the updated model (with its [[effects]]) here")
     u.add_argument("--json", action="store_true", help="print the result as JSON")
     noise_options(u)
@@ -357,7 +360,7 @@ def cmd_update(args) -> int:
     from .text import format_update
 
     outcome = update(model, measured, effects, freq_noise=args.freq_noise,
-                     shape_noise=args.shape_noise)
+                     shape_noise=args.shape_noise, drop=args.drop)
     if args.out is not None:
         save_model(outcome.model, args.out, force=args.force,
                    protect=(args.model, args.measured))

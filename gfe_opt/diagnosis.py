@@ -32,13 +32,19 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
 6. When the best does not bring χ² to the stated (or assumed) noise, the free profiles are
    fitted as well, and a profile that explains significantly more than a best that
    explains only by white residuals is the finding.
-   If the best does not explain: a pair that explains (estimable) is suggested; else a
-   free profile that explains is the finding; else, when the profile is significantly
+   If the best does not explain: a pair that explains (estimable) is suggested (of the
+   firsts the best does not beat significantly, with the same second, the lowest
+   information criterion; :func:`_simplest_first`); else a free profile that explains is
+   the finding; else, when the profile is significantly
    better than the best and no determined pair fitted is significantly better than it,
    nothing named is a finding (``unexplained``); else the best is the finding and
    ``remaining`` says what is left after it.
 7. A finding that another converged end fits as well (not its mirror image on a symmetric
    beam) is not a finding: the data do not determine it (:func:`_undetermined`).
+8. A present local effect whose re-estimate ends on a bound of its range (not its
+   position) is fitted over as every other local kind in its place; one with a lower
+   information criterion than the model as it stands is suggested first, with
+   ``replace`` naming the effect it takes the place of (:func:`_swap`).
 
 Verdict
 -------
@@ -203,6 +209,9 @@ class Diagnosis:
     #: ``unexplained`` because a free profile explains significantly more than every named
     #: effect and pair: its name (the note gives the ``update --add`` argument)
     offered: list = field(default_factory=list)
+    #: a present effect to take out before the suggested one goes in:
+    #: {"effect": name, "index": its place in the model's effects, "by": suggested name}
+    replace: dict | None = None
 
     @property
     def best(self) -> Fit | None:
@@ -232,6 +241,7 @@ class Diagnosis:
                     **self.together.misfit.summary()},
                 "remaining": None if self.remaining is None else jsonable(self.remaining),
                 "offered": list(self.offered),
+                "replace": None if self.replace is None else dict(self.replace),
                 "realisation": list(self.realisation),
                 "notes": list(self.notes)}
 
@@ -681,9 +691,28 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             current = (float("nan") if measured.frequency_only or noise.given else
                shape_correlation(reference.model if reference else model, measured, noise, C))
     verdict = _verdict(ranked, ref_misfit, ref_params, noise, current, measured)
+    swap = _swap(model, measured, noise, reference, names, sel)
+    replace = None
+    if swap is not None:
+        # a present effect that ends on the edge of its range, better read as another
+        # kind at its place: that replacement comes before anything added on top
+        index, alt = swap
+        old = model.effects[index]
+        alt.significant = True
+        ranked = [alt] + [f for f in ranked if f is not alt]
+        for f in ranked[1:]:
+            f.significant = False
+        verdict, suggested, together = "effect_found", [alt.name], None
+        replace = {"effect": old.name, "index": index, "by": alt.name}
+        notes.append(f"the present {old.name} ends on the edge of its range "
+                     f"({', '.join(_on_edge(model, reference.effects[index]))}): a {alt.name} "
+                     f"in its place fits better for its parameters (χ²/n "
+                     f"{ref_misfit.chi2_per_residual:.3g} -> "
+                     f"{alt.misfit.chi2_per_residual:.3g}; {alt.describe()}); replace it: "
+                     f"gfe-opt update MODEL MEASURED --drop {index} --add {alt.name}")
     remaining = None
     if verdict == "effect_found":
-        finding = together if suggested else ranked[0]
+        finding = together if suggested and together is not None else ranked[0]
         if not explains(finding):
             where = compare(finding.model, measured,
                             noise=max(noise.shape, 1e-3)).failure_places()
@@ -693,7 +722,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     words = (words or []) + _band_caution(words, estimate)
     if verdict == "effect_found" and not suggested:
         suggested = [ranked[0].name]
-    alike = _alike(ranked, sel) if verdict == "effect_found" else []
+    alike = _alike(ranked, sel) if verdict == "effect_found" and swap is None else []
     if verdict == "effect_found":
         notes += _ambiguities(ranked[0], alike, measured, noise, C, sel)
     if measured.frequency_only:
@@ -711,7 +740,64 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                      realisation=_words_for_verdict(words or [], verdict),
                      nodal=nodal or [], generic_update=generic, profile_band=band,
                      notes=notes, remaining=remaining,
-                     offered=offered if verdict == "unexplained" else [])
+                     offered=offered if verdict == "unexplained" else [],
+                     replace=replace)
+
+
+def _on_edge(model, effect) -> list[str]:
+    """The parameters of a present ``effect`` that end on a bound of their fitting range
+    (``mass_ratio = 3 (the upper end of its range)``): the data ask for a value this kind
+    cannot take, and another kind may describe what it stands for."""
+    kind = effect_type(effect.name)
+    fixed = {k: effect.parameters[k] for k in kind.fixed_keys() if k in effect.parameters}
+    out = []
+    for v in kind.variables(model, fixed):
+        value = effect.parameters.get(v.key)
+        if v.index is not None or not isinstance(value, (int, float)) or v.key == "position":
+            continue   # (a position on an end is a place, not a limit of the kind)
+        z, span = v.order_one(model, value), 1e-6 * (v.upper - v.lower)
+        if z >= v.upper - span or z <= v.lower + span:
+            end = "upper" if z >= v.upper - span else "lower"
+            out.append(f"{v.key} = {value:.4g}, the {end} end of its range")
+    return out
+
+
+def _swap(model, measured, noise, reference, names, sel):
+    """(index, fit) of the other kind that, in place of a present local effect which ends on
+    the edge of its range (:func:`_on_edge`), has the lower information criterion (the
+    others re-estimated with it), or None.  An effect added early can stand in for one it
+    cannot be (a heavy zone at its largest mass ratio for a point mass, before the shear of
+    a deep beam was added): the loop otherwise never looks at it again."""
+    if reference is None or not reference.success:
+        return None
+    best = None
+    for i, effect in enumerate(reference.effects):
+        kind = effect_type(effect.name)
+        if not kind.local or not _on_edge(model, effect):
+            continue
+        rest = [e for j, e in enumerate(reference.effects) if j != i]
+        base = model.with_effects(rest, check=False)
+        where = effect.parameters.get("position")
+        hint = where / model.length if isinstance(where, (int, float)) else 0.5
+        alts = []
+        for name in names:
+            other = effect_type(name)
+            if name == effect.name or not other.local or getattr(other, "fallback", False) \
+                    or not other.starts(base, hint):
+                continue
+            try:
+                check_enough_modes(measured, [*rest, Effect(name, {})])
+            except GfeInputError:
+                continue
+            alts.append(name)
+        jobs = [("candidate", (base, measured, name, noise, hint)) for name in alts]
+        for alt in _run_jobs(jobs, None, alts) if jobs else []:
+            if not alt.success or alt.unidentified \
+                    or sel.penalised(alt) >= sel.penalised(reference):
+                continue
+            if best is None or sel.penalised(alt) < sel.penalised(best[1]):
+                best = (i, alt)
+    return best
 
 
 def _profile_argument(profile) -> str:
@@ -774,18 +860,41 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
     data (by the information criterion), else None.  When no pair with ``best`` does, the
     other significant candidates that ``best`` does not beat significantly are tried first
     in turn (a short section loss and a crack fit one crack alike; with two cracks only the
-    pair of cracks is determined)."""
+    pair of cracks is determined); once a pair explains, the later of those firsts are tried
+    with its second too (:func:`_simplest_first`)."""
     firsts = [best] + [f for f in _rank([f for f in fits if f.significant and not f.failed],
                                         sel)
                        if f is not best and not sel.better(best, f)
                        and not getattr(effect_type(f.name), "fallback", False)]
     tried = []
-    for first_fit in firsts:
+    for i, first_fit in enumerate(firsts):
         pair, pairs = _pairs_with(model, measured, noise, first_fit, fits, hint, explains, sel)
         tried += [p for p in pairs if sel.better(p, first_fit)]
         if pair is not None:
-            return first_fit, pair, tried
+            return _simplest_first(model, measured, noise, hint, explains, sel, first_fit,
+                                   pair, firsts[i + 1:], tried)
     return best, None, tried
+
+
+def _simplest_first(model, measured, noise, hint, explains, sel, first, pair, others, tried):
+    """The explaining pair (``first`` + ``pair``'s second) against each other first that
+    ``first`` does not beat significantly, with the same second (a further instance of its
+    own kind where the second repeats the first): the lowest information criterion wins.
+    The second effect can absorb what made ``first`` look better alone (a heavy zone and
+    shear against a point mass and shear in a continuum with a block)."""
+    repeat = pair.name == first.name
+    jobs = [("candidate", (model, measured, f.name if repeat else pair.name, noise, hint,
+                           None, (Effect(f.name, f.parameters),), []))
+            for f in others]
+    best = (first, pair)
+    for f, alt in zip(others, _run_jobs(jobs, None, [f.name for f in others])):
+        if not alt.success or alt.unidentified:
+            continue
+        if sel.better(alt, f):
+            tried.append(alt)
+        if explains(alt) and sel.penalised(alt) < sel.penalised(best[1]):
+            best = (f, alt)
+    return best[0], best[1], tried
 
 
 def _pairs_with(model, measured, noise, best, fits, hint, explains, sel):
@@ -1057,24 +1166,29 @@ class UpdateOutcome:
 
 
 def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
-           shape_noise=None) -> UpdateOutcome:
+           shape_noise=None, drop=()) -> UpdateOutcome:
     """Add effect instances (names, ``name:key=value`` strings or :class:`Effect`) and fit
     all of the model's effects' parameters with IPOPT.  The present instances are
     re-estimated from where they are; an added one starts from the values given, the rest
     from the diagnosis of that effect alone.  A global effect already in the model, or
-    added twice, is an error."""
+    added twice, is an error.  ``drop`` takes present instances out first (their index in
+    the model's effects, or a name the model holds once): a diagnosis's ``replace``."""
     noise = noise_of(freq_noise, shape_noise)
     measured, dropped = on_model(measured, model)
     check_model_size(_discretise(model), measured, model.source or model.name)
     check_units(model, measured)
+    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    before = misfit(model, measured, noise, C)
+    if drop:
+        model = model.with_effects(
+            [e for i, e in enumerate(model.effects) if i not in drop_indices(model, drop)],
+            check=False)
     effects = [parse_effect(a, model) if isinstance(a, str) else a for a in add]
     for e in effects:
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
                                      partial=True)
     check_repeats([*model.effects, *effects], "--add", "effects")
     check_enough_modes(measured, [*model.effects, *effects])
-    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
-    before = misfit(model, measured, noise, C)
     hint = None
     starts = []
     for e in effects:
@@ -1115,6 +1229,31 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
                          notes=[*dropped, *equivalent_notes(fit, measured),
                                 *(["not estimable from these data: " + u
                                    for u in fit.unidentified])])
+
+
+def drop_indices(model: Model, drop) -> set:
+    """The places in ``model.effects`` of ``drop`` items: an index (int or digits, from 0 as
+    in ``diagnose --json``'s ``replace.index``) or a name the model holds exactly once."""
+    out = set()
+    names = [e.name for e in model.effects]
+    for item in drop:
+        text = str(item).strip()
+        if text.isdigit():
+            if int(text) >= len(names):
+                raise GfeInputError("--drop", text, f"the model has {len(names)} effect"
+                                    f"{'' if len(names) == 1 else 's'} (indices from 0)")
+            out.add(int(text))
+        elif names.count(text) == 1:
+            out.add(names.index(text))
+        elif text in names:
+            raise GfeInputError("--drop", text, "the model holds it "
+                                f"{names.count(text)} times: give its index instead ("
+                                + ", ".join(str(i) for i, n in enumerate(names) if n == text)
+                                + ")")
+        else:
+            raise GfeInputError("--drop", text, "the model has no such effect (it has: "
+                                + (", ".join(names) or "none") + ")")
+    return out
 
 
 def _default_fixed(kind, model):

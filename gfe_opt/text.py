@@ -138,7 +138,12 @@ def format_diagnosis(result, model) -> str:
                          "after adding it")
         adds = " ".join(f"--add {name}" for name in result.suggested)
         them = "it" if len(result.suggested) == 1 else "them"
-        lines.append(f"  add {them}: gfe-opt update MODEL MEASURED {adds}")
+        swap = getattr(result, "replace", None)
+        if swap is not None:
+            lines.append(f"  in place of the present {swap['effect']} (effects[{swap['index']}]"
+                         f"): gfe-opt update MODEL MEASURED --drop {swap['index']} {adds}")
+        else:
+            lines.append(f"  add {them}: gfe-opt update MODEL MEASURED {adds}")
     elif result.verdict == "unexplained":
         where = ("where the model fails: " + ", ".join(f"x = {x:.3f} m" for x, _ in
                                                        result.localisation)

@@ -61,3 +61,46 @@ def test_a_campaign_subset_meets_the_targets_relaxed_for_its_size():
         (r["name"], r["verdicts"], r["added"]) for r in rows if not r["verdict_right"]]
     assert card["false_alarms"] == 0
     assert np.isfinite(card["seconds_per_case"])
+
+
+def _scored(hidden, added, marginal=(), verdict="consistent"):
+    """The campaign's score of a finished loop that added ``added`` [(name, parameters)]."""
+    from types import SimpleNamespace
+
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import bench_diagnosis
+
+    from .truths import Case
+
+    case = Case("t", "pair" if len(hidden) > 1 else hidden[0].klass, {}, np.zeros(0),
+                np.zeros(0), None, hidden, None, 1.0, in_family=False, signal=1e4,
+                marginal=marginal)
+    effects = [SimpleNamespace(name=n, parameters=p) for n, p in added]
+    row = {"verdicts": [verdict], "final_effects": []}
+    bench_diagnosis._score(row, case, make_model(), SimpleNamespace(sigma=[{}] * len(effects)),
+                           added=effects)
+    return row
+
+
+def test_the_campaign_scores_one_zone_over_two_close_cracks_and_ignores_what_data_cannot_show():
+    """The scorer's rules (scripts/bench_diagnosis.py): two cracks closer than the modes
+    resolve, read as one section loss whose extent holds both, are right; one crack inside
+    a long zone whose centre is far from it is not; an effect of a pair whose own χ² is
+    below truths.DETECTABLE is not required, one the data show is."""
+    from .truths import Hidden
+
+    cracks = [Hidden("crack", 0.354, {"compliance": 6e-6}), Hidden("crack", 0.381,
+                                                                  {"compliance": 5e-6})]
+    zone = ("section_loss", {"position": 0.367, "length": 0.051, "stiffness_ratio": 0.47,
+                             "mass_ratio": 0.94})
+    row = _scored(cracks, [zone], marginal=(9889.0, 13534.0))
+    assert row["verdict_right"] and max(row["position_error_pct"]) < 0.1
+    assert _scored(cracks, [zone[:1] + ({**zone[1], "position": 0.36, "length": 0.01},)],
+                   marginal=(9889.0, 13534.0))["verdict_right"] is False
+    long_zone = ("section_loss", {**zone[1], "position": 0.30, "length": 0.20})
+    assert not _scored(cracks[:1], [long_zone])["verdict_right"]
+    mass = Hidden("mass", 0.2, {"mass": 0.07})
+    material = Hidden("material", None, {"E_ratio": 0.99})
+    found = [("point_mass", {"position": 0.2, "mass": 0.07})]
+    assert _scored([mass, material], found, marginal=(2.6e4, 0.3))["verdict_right"]
+    assert not _scored([mass, material], found, marginal=(2.6e4, 800.0))["verdict_right"]

@@ -110,8 +110,9 @@ def test_diagnose_json_contract(files, capsys):
     data = json.loads(capsys.readouterr().out)
     assert set(data) == {"verdict", "baseline", "noise", "effects", "failed", "skipped",
                          "indistinguishable", "suggested", "together", "realisation",
-                         "notes", "remaining", "offered"}
+                         "notes", "remaining", "offered", "replace"}
     assert data["indistinguishable"] == [] and data["suggested"] == ["crack"]
+    assert data["replace"] is None   # the model holds no effect to replace
     assert data["together"] is None
     assert data["verdict"] == "effect_found"
     # 4 noisy modes of a Christides-Barr crack: the library's crack brings them to the noise
@@ -152,6 +153,21 @@ def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_p
     assert main(["update", str(model), str(measured), "--add", "crack", "--out",
                  str(out)]) == 2
     assert "--force" in capsys.readouterr().err
+    # --drop takes a present effect out before the added one goes in (a diagnosis's
+    # "replace"): by name or by index, never more than the model holds
+    again = tmp_path / "again.toml"
+    assert main(["update", str(out), str(measured), "--drop", "crack", "--add",
+                 "section_loss:position=0.39", "--out", str(again), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [e["effect"] for e in data["effects"]] == ["section_loss"]
+    assert [e.name for e in load_model(again).effects] == ["section_loss"]
+    for drop, match in (("crack", "--drop: crack: the model has no such effect (it has: "
+                                  "section_loss)"),
+                        ("1", "--drop: 1: the model has 1 effect (indices from 0)")):
+        assert main(["update", str(again), str(measured), "--drop", drop, "--add",
+                     "crack"]) == 2
+        err = capsys.readouterr().err
+        assert match in err and err.count("\n") == 1
 
 
 @pytest.mark.parametrize("add,match", [("rust", "unknown effect 'rust'"),

@@ -33,7 +33,9 @@ def loop(model, measured, steps=4, **noise):
         if result.best is None:
             return added, result, model
         added.append(result.best)
-        model = update(model, measured, [result.best.name], **noise).model
+        swap = result.replace   # a present effect to take out first
+        model = update(model, measured, [result.best.name], **noise,
+                       drop=[swap["index"]] if swap else ()).model
     return added, diagnose(model, measured, **noise), model
 
 

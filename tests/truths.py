@@ -84,6 +84,8 @@ class Case:
     in_family: bool             # the package can represent the truth exactly
     signal: float = float("inf")  # χ² of the hidden effects alone (noise-free, in units of
     #                               the data's noise): below DETECTABLE the data cannot show them
+    marginal: tuple = ()        # each hidden effect's own χ² with the others present (pairs:
+    #                             the truth against the truth without it); () when not computed
 
 
 # -------------------------------------------------------------------------------------------
@@ -232,29 +234,19 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
     h = BEAM["h"]
     EI = BEAM["E"] * BEAM["b"] * h**3 / 12
     rho_a = BEAM["rho"] * BEAM["b"] * h
-    hidden, changes = [], {}
+    hidden, each = [], []
     for c in classes:
         if c == "none":
             continue
         hid, ch = _effect(c, rng, supports, L, EI, rho_a, h, law)
         hidden.append(hid)
-        for key, value in ch.items():
-            if key in ("rigidity", "mass"):
-                changes[key] = product(*(f for f in (changes.get(key), value) if f is not None))
-            elif key in ("hinges", "point_masses", "point_springs"):
-                changes[key] = changes.get(key, []) + value
-            elif key == "end_springs":
-                changes[key] = {**changes.get(key, {}), **value}
-            else:
-                changes[key] = value
-    truth_supports = list(supports)
-    if changes.pop("free_right", False):
-        truth_supports[1] = "free"
-    released = changes.pop("release", None)   # a clamp that gives: pinned + end spring
-    if released:
-        truth_supports[0 if released == "left" else 1] = "pinned"
-    beam = ReferenceBeam(length=L, EI=EI, rho_a=rho_a, supports=tuple(truth_supports),
-                         elements=800, **changes)
+        each.append(ch)
+
+    def truth_beam(parts):
+        return ReferenceBeam(length=L, EI=EI, rho_a=rho_a, elements=800,
+                             **_merge(supports, parts))
+
+    beam = truth_beam(each)
     n_modes = int(rng.integers(3, 9))
     if frequency_only:
         n_modes = max(n_modes, 6)
@@ -272,6 +264,14 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
     plain = ReferenceBeam(length=L, EI=EI, rho_a=rho_a, supports=supports, elements=800)
     f0, y0 = plain.measure(n_modes + rigid, x, shape_noise=0.0, freq_noise=0.0)
     signal = _signal(freqs, shapes, f0[rigid:], y0[:, rigid:], factor, frequency_only)
+    marginal = (signal,) if len(each) == 1 else ()
+    if len(each) > 1:   # each effect's own χ² with the others present
+        marginal = tuple(
+            _signal(freqs, shapes, *(a[rigid:] if a.ndim == 1 else a[:, rigid:] for a in
+                                     truth_beam(each[:i] + each[i + 1:]).measure(
+                                         n_modes + rigid, x, shape_noise=0.0,
+                                         freq_noise=0.0)), factor, frequency_only)
+            for i in range(len(each)))
     freqs, shapes = add_noise(freqs, shapes, factor * SHAPE_NOISE, factor * FREQ_NOISE,
                               seed + 1)
     stated = (factor * FREQ_NOISE, factor * SHAPE_NOISE) if rng.integers(2) else None
@@ -281,7 +281,29 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
                 model_dict(supports, elements), x, freqs,
                 None if frequency_only else shapes, hidden, stated, factor,
                 in_family=all(hd.law in ("", "christides_barr") for hd in hidden)
-                and klass not in ("taper",), signal=signal)
+                and klass not in ("taper",), signal=signal, marginal=marginal)
+
+
+def _merge(supports, parts) -> dict:
+    """ReferenceBeam keywords (``supports`` included) of the effects' changes ``parts``."""
+    changes = {}
+    for ch in parts:
+        for key, value in ch.items():
+            if key in ("rigidity", "mass"):
+                changes[key] = product(*(f for f in (changes.get(key), value) if f is not None))
+            elif key in ("hinges", "point_masses", "point_springs"):
+                changes[key] = changes.get(key, []) + value
+            elif key == "end_springs":
+                changes[key] = {**changes.get(key, {}), **value}
+            else:
+                changes[key] = value
+    truth_supports = list(supports)
+    if changes.pop("free_right", False):
+        truth_supports[1] = "free"
+    released = changes.pop("release", None)   # a clamp that gives: pinned + end spring
+    if released:
+        truth_supports[0 if released == "left" else 1] = "pinned"
+    return {**changes, "supports": tuple(truth_supports)}
 
 
 #: a hidden effect whose own χ² (noise-free) is below this cannot be told from noise by any
