@@ -55,6 +55,7 @@ Verdict
 
 from __future__ import annotations
 
+import functools
 import multiprocessing
 import os
 import time
@@ -478,6 +479,20 @@ def _floor(fits) -> float:
     return max(1.0, min(values)) if values else 1.0
 
 
+def one_blas_thread(fn):
+    """Run ``fn`` with one BLAS thread, as the fit workers do: the same rounding in this
+    process as in theirs, whatever the machine's core count (an update reproduces the fit
+    its diagnosis made; a diagnosis does not hinge on how many threads BLAS took)."""
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(limits=1):
+            return fn(*args, **kwargs)
+    return wrapper
+
+
+@one_blas_thread
 def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
              freq_noise=None, shape_noise=None, progress=None,
              realise: bool = False) -> Diagnosis:
@@ -1165,6 +1180,7 @@ class UpdateOutcome:
                 "effects": [self.fit.effect_json(i) for i in range(len(self.fit.effects))]}
 
 
+@one_blas_thread
 def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
            shape_noise=None, drop=()) -> UpdateOutcome:
     """Add effect instances (names, ``name:key=value`` strings or :class:`Effect`) and fit
