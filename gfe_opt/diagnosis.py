@@ -1195,10 +1195,12 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     check_units(model, measured)
     C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     before = misfit(model, measured, noise, C)
+    taken = []
     if drop:
-        model = model.with_effects(
-            [e for i, e in enumerate(model.effects) if i not in drop_indices(model, drop)],
-            check=False)
+        out = drop_indices(model, drop)
+        taken = [f"taken out first: {model.effects[i].name} (effects[{i}])" for i in sorted(out)]
+        model = model.with_effects([e for i, e in enumerate(model.effects) if i not in out],
+                                   check=False)
     effects = [parse_effect(a, model) if isinstance(a, str) else a for a in add]
     for e in effects:
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
@@ -1242,7 +1244,7 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
                              f"{fit.status})")
     return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit,
                          added=list(range(len(model.effects), len(fit.effects))),
-                         notes=[*dropped, *equivalent_notes(fit, measured),
+                         notes=[*taken, *dropped, *equivalent_notes(fit, measured),
                                 *(["not estimable from these data: " + u
                                    for u in fit.unidentified])])
 

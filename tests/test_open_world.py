@@ -242,6 +242,7 @@ def test_a_heavy_zone_standing_for_an_attached_mass_is_replaced_by_a_point_mass(
     outcome = update(model, measured, ["point_mass"], drop=[diagnosis.replace["index"]],
                      **NOISE)
     assert [e.name for e in outcome.model.effects] == ["point_mass"]
+    assert "taken out first: section_loss (effects[0])" in outcome.notes
     p = outcome.model.effects[0].parameters
     assert abs(p["position"] - at) <= 0.01 * L and abs(p["mass"] / mass - 1) <= 0.03
     assert outcome.after.chi2_per_residual < 2.0
