@@ -713,7 +713,11 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         # kind at its place: that replacement comes before anything added on top
         index, alt = swap
         old = model.effects[index]
-        alt.significant = True
+        # judged by the information criterion against the model as it stands (it has no
+        # more parameters): nothing further to need; its size as for any candidate
+        alt.gain, alt.threshold, alt.significant = sel.reference_chi2 - alt.misfit.chi2, 0.0, True
+        alt.size_sigmas = effect_type(alt.name).size_in_sigmas(
+            model.with_effects([], check=False), alt.parameters, alt.uncertainty)
         ranked = [alt] + [f for f in ranked if f is not alt]
         for f in ranked[1:]:
             f.significant = False

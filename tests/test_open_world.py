@@ -237,6 +237,9 @@ def test_a_heavy_zone_standing_for_an_attached_mass_is_replaced_by_a_point_mass(
     assert diagnosis.verdict == "effect_found" and diagnosis.suggested == ["point_mass"]
     assert diagnosis.replace == {"effect": "section_loss", "index": 0, "by": "point_mass"}
     assert diagnosis.to_json()["replace"] == diagnosis.replace
+    # the replacement is the finding the table and JSON show first, with its own gain
+    assert diagnosis.best.name == "point_mass" and diagnosis.best.gain > 0
+    assert diagnosis.best.size_sigmas > 3
     assert any("ends on the edge of its range" in n and "--drop 0" in n
                for n in diagnosis.notes)
     outcome = update(model, measured, ["point_mass"], drop=[diagnosis.replace["index"]],
