@@ -141,3 +141,14 @@ def test_a_bar_is_diagnosed_with_no_options():
     tried = {f.name for f in last.fits} | {f.name for f in last.failed}
     assert not tried & {"crack", "shear", "axial_load", "foundation", "support_spring"}
     assert last.verdict == "consistent"
+
+
+def test_update_reproduces_the_fit_its_diagnosis_made_to_the_last_bit():
+    """update keeps the candidate's own fit, and both run with one BLAS thread (the fit
+    workers' arithmetic), so the χ² and parameters update prints are the diagnosis's."""
+    measured = reference_data(rigidity=christides_barr(0.19, 0.5))
+    diagnosis = diagnose(make_model(), measured, candidates=["crack"], **NOISE)
+    outcome = update(make_model(), measured, ["crack"], **NOISE)
+    fit = diagnosis.fits[0]
+    assert fit.name == "crack" and outcome.after.chi2 == fit.misfit.chi2
+    assert outcome.model.effects[0].parameters == fit.parameters
