@@ -78,6 +78,7 @@ from .fitting import (
     Fit,
     Misfit,
     Noise,
+    bound_side,
     fit_effects,
     jsonable,
     lowest,
@@ -711,7 +712,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     if swap is not None:
         # a present effect that ends on the edge of its range, better read as another
         # kind at its place: that replacement comes before anything added on top
-        index, alt = swap
+        index, alt, edges = swap
         old = model.effects[index]
         # judged by the information criterion against the model as it stands (it has no
         # more parameters): nothing further to need; its size as for any candidate
@@ -724,7 +725,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         verdict, suggested, together = "effect_found", [alt.name], None
         replace = {"effect": old.name, "index": index, "by": alt.name}
         notes.append(f"the present {old.name} ends on the edge of its range "
-                     f"({', '.join(_on_edge(model, reference.effects[index]))}): a {alt.name} "
+                     f"({', '.join(edges)}): a {alt.name} "
                      f"in its place fits better for its parameters (χ²/n "
                      f"{ref_misfit.chi2_per_residual:.3g} -> "
                      f"{alt.misfit.chi2_per_residual:.3g}; {alt.describe()}); replace it: "
@@ -774,15 +775,14 @@ def _on_edge(model, effect) -> list[str]:
         value = effect.parameters.get(v.key)
         if v.index is not None or not isinstance(value, (int, float)) or v.key == "position":
             continue   # (a position on an end is a place, not a limit of the kind)
-        z, span = v.order_one(model, value), 1e-6 * (v.upper - v.lower)
-        if z >= v.upper - span or z <= v.lower + span:
-            end = "upper" if z >= v.upper - span else "lower"
+        end = bound_side(v.order_one(model, value), v.lower, v.upper)
+        if end is not None:
             out.append(f"{v.key} = {value:.4g}, the {end} end of its range")
     return out
 
 
 def _swap(model, measured, noise, reference, names, sel):
-    """(index, fit) of the other kind that, in place of a present local effect which ends on
+    """(index, fit, edges) of the other kind that, in place of a present local effect which ends on
     the edge of its range (:func:`_on_edge`), has the lower information criterion (the
     others re-estimated with it), or None.  An effect added early can stand in for one it
     cannot be (a heavy zone at its largest mass ratio for a point mass, before the shear of
@@ -792,7 +792,8 @@ def _swap(model, measured, noise, reference, names, sel):
     best = None
     for i, effect in enumerate(reference.effects):
         kind = effect_type(effect.name)
-        if not kind.local or not _on_edge(model, effect):
+        edges = _on_edge(model, effect) if kind.local else []
+        if not edges:
             continue
         rest = [e for j, e in enumerate(reference.effects) if j != i]
         base = model.with_effects(rest, check=False)
@@ -815,7 +816,7 @@ def _swap(model, measured, noise, reference, names, sel):
                     or sel.penalised(alt) >= sel.penalised(reference):
                 continue
             if best is None or sel.penalised(alt) < sel.penalised(best[1]):
-                best = (i, alt)
+                best = (i, alt, edges)
     return best
 
 

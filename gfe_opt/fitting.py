@@ -902,6 +902,17 @@ IDENTIFIABLE_CORRELATION = 0.99
 TRADE_STEP_SIGMAS = 2.0
 
 
+def bound_side(z: float, lower: float, upper: float) -> str | None:
+    """``"upper"`` or ``"lower"`` when an order-one variable ``z`` ends on that bound of
+    [lower, upper] (within 10⁻⁶ of the range: IPOPT stops a hair inside), else None."""
+    span = 1e-6 * (upper - lower)
+    if z >= upper - span:
+        return "upper"
+    if z <= lower + span:
+        return "lower"
+    return None
+
+
 def _saturated(slots, z, lower, upper) -> list:
     """Per slot, its log-scaled variables (stiffnesses over decades) that end on a bound of
     their range: ``{key: "at least"}`` on the upper one, ``"at most"`` on the lower.  The
@@ -911,11 +922,9 @@ def _saturated(slots, z, lower, upper) -> list:
     for slot in slots:
         marks = {}
         for v in slot.variables:
-            span = 1e-6 * (upper[i] - lower[i])
-            if v.log and v.index is None and z[i] >= upper[i] - span:
-                marks[v.key] = "at least"
-            elif v.log and v.index is None and z[i] <= lower[i] + span:
-                marks[v.key] = "at most"
+            side = bound_side(z[i], lower[i], upper[i]) if v.log and v.index is None else None
+            if side is not None:
+                marks[v.key] = "at least" if side == "upper" else "at most"
             i += 1
         out.append(marks)
     return out
