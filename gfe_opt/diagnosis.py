@@ -36,9 +36,11 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
    firsts the best does not beat significantly, with the same second, the lowest
    information criterion; :func:`_simplest_first`); else a free profile that explains is
    the finding; else, when the profile is significantly
-   better than the best and no determined pair fitted is significantly better than it,
-   nothing named is a finding (``unexplained``); else the best is the finding and
-   ``remaining`` says what is left after it.
+   better than the best and no determined pair fitted is significantly better than it:
+   the pair with the lowest information criterion that the profile does not beat
+   significantly is the finding (:func:`_tied_pair`), and if the profile beats every pair,
+   nothing named is a finding (``unexplained``); else the best is the finding.  With a
+   finding that does not explain, ``remaining`` says what is left after it.
 7. A finding that another converged end fits as well (not its mirror image on a symmetric
    beam) is not a finding: the data do not determine it (:func:`_undetermined`).
 8. A present local effect whose re-estimate ends on a bound of its range (not its
@@ -623,6 +625,20 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                              f"{profile.name} explains it to the noise")
                 best.significant = False
             elif profile is not None and profile.significant and sel.better(profile, best) \
+                    and not rivalled and (tied := _tied_pair(tried, profile, sel)) is not None:
+                # the free profile explains significantly more than every named effect
+                # alone but not more than a determined pair: the pair is the finding, with
+                # what remains after it (a notch in a continuum read with the E that the
+                # continuum's own stiffness asks for)
+                first_name = tied.effects[tied.added - 1].name
+                suggested, together = [first_name, tied.name], tied
+                notes.append(f"{first_name} with a further {tied.name} explains as much as a "
+                             f"free {profile.name} (χ²/n "
+                             f"{tied.misfit.chi2_per_residual:.3g} against "
+                             f"{profile.misfit.chi2_per_residual:.3g}): add them together")
+                notes += equivalent_notes(tied, measured)
+                profile.significant = False
+            elif profile is not None and profile.significant and sel.better(profile, best) \
                     and not rivalled:
                 # a free profile explains significantly more than every named effect and
                 # pair: no named finding; how the structure differs is the profile
@@ -840,6 +856,14 @@ def _discretise(model):
 def _best(fits, sel):
     significant = [f for f in fits if f.significant and not f.failed]
     return _rank(significant, sel)[0] if significant else None
+
+
+def _tied_pair(tried, profile, sel):
+    """Of the determined pairs fitted (each significant over its first), the one with the
+    lowest information criterion that the free ``profile`` does not beat significantly;
+    None if it beats them all."""
+    level = [p for p in tried if p.added is not None and not sel.better(profile, p)]
+    return _rank(level, sel)[0] if level else None
 
 
 def _rank(fits, sel) -> list:

@@ -150,10 +150,49 @@ def test_data_no_single_structure_produces_are_unexplained():
         freqs.append(f[n])
         shapes.append(y[:, n])
     measured = make_measured(s, "w", freqs, np.array(shapes).T, "mode-dependent")
-    added, last, _ = loop(make_model(), measured, steps=3)
-    assert added == [] and last.verdict == "unexplained"
-    assert any("explains part of the difference" in n for n in last.notes)
-    assert any("correlated from sensor to sensor" in n for n in last.notes)
+    model, verdicts = make_model(), []
+    for _ in range(3):
+        d = diagnose(model, measured, **NOISE)
+        verdicts.append(d.verdict)
+        if d.verdict != "effect_found":
+            break
+        # a finding here (a pair that fits as well as the free profile) must say that a
+        # difference remains, and how much: far above the noise, correlated
+        assert d.remaining is not None and d.remaining["chi2_per_residual"] > 20, d.remaining
+        model = update(model, measured, list(d.suggested), **NOISE).model
+    assert verdicts[-1] == "unexplained" and "consistent" not in verdicts, verdicts
+    assert any("correlated from sensor to sensor" in n for n in d.notes)
+    assert d.current.chi2_per_residual > 20
+
+
+def test_a_notch_in_a_pinned_continuum_with_noise_above_the_stated_is_found():
+    """A 2-D plane-stress beam on pins at mid-height (tests/continuum.py) with a real notch,
+    noise twice the assumed level, no noise given (the first such case of the held-out
+    generator above seed 3000).  No named effect alone comes near the free profile (the
+    continuum's shear and E absorb into it), but E with a crack fits as well as the profile
+    does: that pair is the finding, and the loop ends with the crack at the notch."""
+    from gfe_opt.model import model_from_dict
+
+    from .truths import continuum_case
+
+    case = continuum_case(3017)
+    assert case.group == "continuum" and case.stated is None and case.noise_factor == 2.0
+    notch = case.hidden[0].position
+    model = model_from_dict(case.model, case.name)
+    measured = make_measured(case.x, "w", case.frequencies, case.shapes, case.name)
+    first = None
+    for _ in range(5):
+        d = diagnose(model, measured)
+        first = first or d
+        if d.verdict != "effect_found":
+            break
+        swap = d.replace
+        model = update(model, measured, list(d.suggested),
+                       drop=[swap["index"]] if swap else ()).model
+    assert "crack" in first.suggested and first.remaining is not None, first.notes
+    assert d.verdict == "consistent", (d.verdict, d.notes)
+    cracks = [e.parameters["position"] for e in model.effects if e.name == "crack"]
+    assert len(cracks) == 1 and abs(cracks[0] - notch) <= 0.02 * L, (cracks, notch)
 
 
 def test_noise_ten_times_the_stated_level_is_said_not_explained():
