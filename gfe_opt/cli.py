@@ -112,7 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
     u = sub.add_parser("update", help="add effects, fit their parameters, see the error fall")
     u.add_argument("model", help="model file (.toml)")
     u.add_argument("measured", help="measured modes (.json, .csv, .uff, .unv)")
-    u.add_argument("--add", action="append", required=True, metavar="EFFECT",
+    u.add_argument("--add", action="append", default=[], metavar="EFFECT",
                    help="effect instance to add, e.g. crack or crack:position=0.2 "
                         "(repeatable; local effects may be added several times; known: "
                         f"{', '.join(EFFECTS)})")
@@ -349,6 +349,9 @@ def cmd_diagnose(args) -> int:
 
 
 def cmd_update(args) -> int:
+    if not args.add and not args.drop:
+        raise GfeInputError("update", None, "nothing to do: give an effect to add (--add) or "
+                            "a present one to take out (--drop)")
     model, measured = _inputs(args)
     from .model import parse_effect, save_model
 

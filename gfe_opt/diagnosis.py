@@ -47,6 +47,9 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
    position) is fitted over as every other local kind in its place; one with a lower
    information criterion than the model as it stands is suggested first, with
    ``replace`` naming the effect it takes the place of (:func:`_swap`).
+9. Each present effect is taken out in turn, the others re-estimated; one whose removal
+   raises χ² by less than the threshold of step 3 for its parameters is ``not_needed``
+   (:func:`_not_needed`): said, with its ``update --drop``; no verdict changes.
 
 Verdict
 -------
@@ -216,6 +219,10 @@ class Diagnosis:
     #: a present effect to take out before the suggested one goes in:
     #: {"effect": name, "index": its place in the model's effects, "by": suggested name}
     replace: dict | None = None
+    #: present effects the others make unnecessary: [{"effect", "index", "chi2_rise",
+    #: "needed"}] (taking one out, the others re-estimated, raises χ² by less than a
+    #: candidate must lower it to be added)
+    not_needed: list = field(default_factory=list)
 
     @property
     def best(self) -> Fit | None:
@@ -246,6 +253,7 @@ class Diagnosis:
                 "remaining": None if self.remaining is None else jsonable(self.remaining),
                 "offered": list(self.offered),
                 "replace": None if self.replace is None else dict(self.replace),
+                "not_needed": [jsonable(d) for d in self.not_needed],
                 "realisation": list(self.realisation),
                 "notes": list(self.notes)}
 
@@ -326,6 +334,32 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
     return best
 
 
+def _fit_without(model, measured, noise, index):
+    """The model's other effects re-estimated without its effect ``index``."""
+    rest = [e for j, e in enumerate(model.effects) if j != index]
+    return fit_effects(model.with_effects(rest, check=False), measured, [], noise=noise)
+
+
+def _not_needed(model, reference, without, sel) -> list[dict]:
+    """The present effects whose removal (the others re-estimated: ``without``) raises χ²
+    by less than a candidate with their parameters must lower it to be significant (the
+    same floor and level, selection step 3): backward elimination's test.  An effect added
+    early can become unnecessary once later ones are in (a crack and a mass near a clamp
+    chasing a continuum's clamp, after a clamp spring and the doubler's zone are added)."""
+    out = []
+    for i, fit in enumerate(without):
+        name = model.effects[i].name
+        p = reference.n_params - fit.n_params
+        if p < 1 or not fit.success:
+            continue
+        rise = fit.misfit.chi2 - reference.misfit.chi2
+        needed = sel.floor * quantile(p, sel.alpha(name))
+        if rise < needed:
+            out.append({"effect": name, "index": i, "chi2_rise": float(rise),
+                        "needed": float(needed)})
+    return out
+
+
 def _preferred(fit, other) -> bool:
     """``fit`` is the better of two fits of one candidate: converged before not, then a
     lower χ² beyond rounding (a tie keeps the earlier)."""
@@ -349,7 +383,7 @@ def _job(args):
     kind, payload = args
     before = SOLVER_TALLY.copy()
     result = {"profile": _fit_profile, "candidate": _fit_candidate,
-              "generic": _generic_update}[kind](*payload)
+              "generic": _generic_update, "without": _fit_without}[kind](*payload)
     return result, SOLVER_TALLY - before
 
 
@@ -540,12 +574,19 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     if candidates is not None and not jobs and not fallback_names:
         raise GfeInputError(measured.source, "modes", "; ".join(f"{n}: {r}"
                                                                 for n, r in skipped))
+    # each present effect taken out, the others re-estimated: is it still needed?
+    drops = list(range(len(model.effects))) if reference is not None else []
+    for i in drops:
+        jobs.append(("without", (model, measured, noise, i)))
+        labels.append(f"without {model.effects[i].name}")
     with_generic = realise and model.kind == "beam" and not measured.frequency_only
     if with_generic:  # the paper's generic update runs beside the candidates
         jobs.append(("generic", (model, measured, noise)))
         labels.append("generic-element update")
     fits = _run_jobs(jobs, progress, labels) if jobs else []
     generic, band = fits.pop() if with_generic else (None, None)
+    without = fits[len(fits) - len(drops):]
+    fits = fits[:len(fits) - len(drops)]
     for f in fits:
         # no better than the model without it (by less than half a unit of χ²: an effect
         # at its null, whose other parameters then do not matter and may not converge): a
@@ -766,6 +807,13 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         if realise and model.kind == "beam":
             notes.append("the generic-element update needs mode shapes: not run")
     notes += _noise_notes(estimate, verdict, measured)
+    not_needed = _not_needed(model, reference, without, sel) if drops else []
+    for d in not_needed:
+        notes.append(f"the present {d['effect']} (effects[{d['index']}]) is not needed with the "
+                     f"others: taking it out, the others re-estimated, raises χ² by "
+                     f"{d['chi2_rise']:.3g}, less than the {d['needed']:.3g} an effect of its "
+                     f"parameters must explain to be added; the data do not determine it "
+                     f"(to take it out: gfe-opt update MODEL MEASURED --drop {d['index']})")
     if skipped:
         notes.append(_skipped_note(skipped, measured, model))
     return Diagnosis(baseline=baseline, reference=reference, fits=ranked, failed=failed,
@@ -777,7 +825,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                      nodal=nodal or [], generic_update=generic, profile_band=band,
                      notes=notes, remaining=remaining,
                      offered=offered if verdict == "unexplained" else [],
-                     replace=replace)
+                     replace=replace, not_needed=not_needed)
 
 
 def _on_edge(model, effect) -> list[str]:
@@ -1238,8 +1286,9 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     check_enough_modes(measured, [*model.effects, *effects])
     hint = None
     starts = []
+    single = None   # the last effect's candidate fit: every effect re-estimated with it
     for e in effects:
-        single = None   # the last effect's candidate fit: every effect re-estimated with it
+        single = None
         kind = effect_type(e.name)
         fitted = [v.key for v in kind.variables(model, {**_default_fixed(kind, model),
                                                        **e.parameters})]

@@ -150,6 +150,8 @@ def run_case(case) -> dict:
             row["verdicts"].append(result.verdict)
         row["final_chi2_per_residual"] = result.current.chi2_per_residual
         row["remaining"] = getattr(result, "remaining", None)
+        # present effects the last diagnosis says the others make unnecessary (step 9)
+        row["not_needed"] = [n["effect"] for n in result.not_needed]
         _score(row, case, model, fit)
     except GfeInputError as exc:
         row["exit"] = 2
@@ -462,6 +464,10 @@ def _print(doc, with_sweep) -> None:
         m = "-" if t["measured"] is None else f"{t['measured']:.3g}"
         print(f"  {t['target']:<66}{m:>7}  goal {t['goal']:<6} "
               f"{'met' if t['met'] else 'NOT MET'}")
+    flagged = [r for r in doc["cases"] if r.get("not_needed")]
+    print(f"\nlast diagnoses naming present effects not needed (step 9): {len(flagged)} "
+          f"cases, {sum(not r['verdict_right'] for r in flagged)} of them wrong"
+          + "".join(f"\n  {r['name']}: {', '.join(r['not_needed'])}" for r in flagged))
     if with_sweep:
         print("\nsweep of the first diagnosis (α: significance level before the look-"
               "elsewhere division; size: σ from 'no effect'):")

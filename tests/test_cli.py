@@ -110,9 +110,10 @@ def test_diagnose_json_contract(files, capsys):
     data = json.loads(capsys.readouterr().out)
     assert set(data) == {"verdict", "baseline", "noise", "effects", "failed", "skipped",
                          "indistinguishable", "suggested", "together", "realisation",
-                         "notes", "remaining", "offered", "replace"}
+                         "notes", "remaining", "offered", "replace", "not_needed"}
     assert data["indistinguishable"] == [] and data["suggested"] == ["crack"]
     assert data["replace"] is None   # the model holds no effect to replace
+    assert data["not_needed"] == []  # nor one to take out
     assert data["together"] is None
     assert data["verdict"] == "effect_found"
     # 4 noisy modes of a Christides-Barr crack: the library's crack brings them to the noise
@@ -168,6 +169,17 @@ def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_p
                      "crack"]) == 2
         err = capsys.readouterr().err
         assert match in err and err.count("\n") == 1
+    # --drop alone takes an effect out (a diagnosis's "not_needed"); neither is an error
+    bare = tmp_path / "bare.toml"
+    assert main(["update", str(again), str(measured), "--drop", "0", "--out", str(bare),
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["effects"] == [] and not load_model(bare).effects
+    # the zone stood for the crack: without it the misfit is the model's without effects
+    assert data["after"]["chi2_per_residual"] > 10 * data["before"]["chi2_per_residual"]
+    assert main(["update", str(again), str(measured)]) == 2
+    err = capsys.readouterr().err
+    assert "nothing to do" in err and err.count("\n") == 1
 
 
 @pytest.mark.parametrize("add,match", [("rust", "unknown effect 'rust'"),

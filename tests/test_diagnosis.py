@@ -9,6 +9,7 @@ import pytest
 
 from gfe_opt.diagnosis import diagnose, update
 from gfe_opt.measured import make_measured
+from gfe_opt.model import Effect
 
 from .conftest import make_model
 from .reference import ReferenceBeam, add_noise, christides_barr, interior, timoshenko_ss
@@ -152,3 +153,22 @@ def test_update_reproduces_the_fit_its_diagnosis_made_to_the_last_bit():
     fit = diagnosis.fits[0]
     assert fit.name == "crack" and outcome.after.chi2 == fit.misfit.chi2
     assert outcome.model.effects[0].parameters == fit.parameters
+
+
+def test_a_present_effect_the_others_make_unnecessary_is_said_and_can_be_dropped():
+    """Backward elimination's test: a model holding the crack the data have (reference
+    beam, Christides–Barr at 0.19 m) and a point mass they do not.  Re-estimated, the mass
+    goes to nothing: taking it out raises χ² by less than it would need to be added, so the
+    diagnosis names it (index, rise, threshold) with the `--drop` to take it out; the crack
+    is needed.  Dropped, the model fits as well as before."""
+    measured = reference_data(rigidity=christides_barr(0.19, 0.5))
+    model = make_model().with_effects([Effect("crack", {"position": 0.2, "depth_ratio": 0.4}),
+                                       Effect("point_mass", {"position": 0.4, "mass": 0.05})])
+    d = diagnose(model, measured, **NOISE)
+    assert [(n["effect"], n["index"]) for n in d.not_needed] == [("point_mass", 1)], d.not_needed
+    assert d.not_needed[0]["chi2_rise"] < d.not_needed[0]["needed"]
+    assert any("--drop 1" in n for n in d.notes)
+    after = update(model, measured, [], drop=[1], **NOISE)
+    assert [e.name for e in after.model.effects] == ["crack"]
+    assert after.after.chi2 - d.current.chi2 < d.not_needed[0]["needed"]
+    assert diagnose(after.model, measured, **NOISE).not_needed == []

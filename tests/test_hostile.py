@@ -163,6 +163,13 @@ def _group_members(pgid: int) -> list[int]:
     return members
 
 
+def _default_sigint():
+    """Ctrl-C's default disposition in the child, as in a terminal: a suite started in the
+    background by a non-interactive shell (``pytest &``) has SIGINT ignored, the child
+    inherits that, and Python then installs no KeyboardInterrupt handler (it exited 0)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_is_one_line_exit_130_no_file_no_worker_left(files, tmp_path):
     _, model, measured = files
     # a finer model than the fixture's: the diagnosis lasts long enough to be interrupted
@@ -174,7 +181,7 @@ def test_ctrl_c_is_one_line_exit_130_no_file_no_worker_left(files, tmp_path):
                             " sys.exit(main())", "diagnose", str(fine), str(measured),
                             "--report", str(report)],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                           start_new_session=True)
+                           start_new_session=True, preexec_fn=_default_sigint)
     deadline = time.monotonic() + 60
     while len(_group_members(run.pid)) < 2 and run.poll() is None:  # until workers fit
         assert time.monotonic() < deadline, "no worker started"
