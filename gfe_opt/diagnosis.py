@@ -812,7 +812,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         notes.append(f"the present {d['effect']} (effects[{d['index']}]) is not needed with the "
                      f"others: taking it out, the others re-estimated, raises χ² by "
                      f"{d['chi2_rise']:.3g}, less than the {d['needed']:.3g} an effect of its "
-                     f"parameters must explain to be added; the data do not determine it "
+                     f"parameters must explain to be added: the data do not need it "
                      f"(to take it out: gfe-opt update MODEL MEASURED --drop {d['index']})")
     if skipped:
         notes.append(_skipped_note(skipped, measured, model))
