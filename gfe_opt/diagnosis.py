@@ -353,7 +353,7 @@ def _not_needed(model, reference, without, sel) -> list[dict]:
         if p < 1 or not fit.success:
             continue
         rise = fit.misfit.chi2 - reference.misfit.chi2
-        needed = sel.floor * quantile(p, sel.alpha(name))
+        needed = sel.needed(p, name)
         if rise < needed:
             out.append({"effect": name, "index": i, "chi2_rise": float(rise),
                         "needed": float(needed)})
@@ -475,8 +475,12 @@ class _Selection:
         return (1.0 - SIGNIFICANCE_LEVEL) / (max(self.n_candidates, 1) * places)
 
     def threshold(self, fit: Fit) -> float:
-        return self.floor * quantile(fit.n_params - self.reference_params,
-                                     self.alpha(fit.name))
+        return self.needed(fit.n_params - self.reference_params, fit.name)
+
+    def needed(self, p: int, name: str) -> float:
+        """The drop in χ² that ``p`` more parameters of effect ``name`` must bring to be
+        significant (step 3); what taking them out must raise it by to be needed (step 9)."""
+        return self.floor * quantile(p, self.alpha(name))
 
     def penalised(self, fit: Fit) -> float:
         """Bayesian information criterion in units of the noise floor, χ²/s² + p ln n: the
@@ -1288,7 +1292,7 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     starts = []
     single = None   # the last effect's candidate fit: every effect re-estimated with it
     for e in effects:
-        single = None
+        single = None   # (an effect given in full or a profile, after one fitted, has none)
         kind = effect_type(e.name)
         fitted = [v.key for v in kind.variables(model, {**_default_fixed(kind, model),
                                                        **e.parameters})]

@@ -162,8 +162,9 @@ def test_a_present_effect_the_others_make_unnecessary_is_said_and_can_be_dropped
     diagnosis names it (index, rise, threshold) with the `--drop` to take it out; the crack
     is needed.  Dropped, the model fits as well as before."""
     measured = reference_data(rigidity=christides_barr(0.19, 0.5))
-    model = make_model().with_effects([Effect("crack", {"position": 0.2, "depth_ratio": 0.4}),
-                                       Effect("point_mass", {"position": 0.4, "mass": 0.05})])
+    cracked = update(make_model(), measured, ["crack"], **NOISE).model  # the user's crack
+    model = cracked.with_effects([*cracked.effects,
+                                  Effect("point_mass", {"position": 0.4, "mass": 0.05})])
     d = diagnose(model, measured, **NOISE)
     assert [(n["effect"], n["index"]) for n in d.not_needed] == [("point_mass", 1)], d.not_needed
     assert d.not_needed[0]["chi2_rise"] < d.not_needed[0]["needed"]
