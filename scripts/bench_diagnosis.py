@@ -8,7 +8,11 @@ every support, other crack laws, smooth zones, tapers, deep beams, frequency-onl
 noise 1-3x the issue's level, stated to ``diagnose`` in about half the cases).  For each
 case: ``diagnose``; while the verdict is ``effect_found``, ``update`` with what it suggests
 (taking out first what it says to ``replace``) and ``diagnose`` again (at most 4
-rounds), as a user at the command line would (the library calls the commands make; an
+additions); when a diagnosis that finds nothing to add lists present effects as not needed,
+take out the least needed (``update --drop``: smallest χ² rise against what it would need)
+and diagnose again, unless that turns ``consistent`` into another verdict (then it stays and
+the loop ends); stop when the model comes back to a set of effects it had before; as a
+user at the command line would (the library calls the commands make; an
 input error is counted as the CLI's exit code 2, anything else raised as an internal
 error).
 
@@ -136,17 +140,35 @@ def run_case(case) -> dict:
         row["first_chi2_per_residual"] = result.baseline.chi2_per_residual
         row["first_candidates"] = _candidates_of(result)
         fit = None
-        for _ in range(ROUNDS):
-            if result.verdict != "effect_found":
+        adds = 0
+        seen = {_state(model)}
+        while True:
+            if result.verdict == "effect_found" and adds < ROUNDS:
+                adds += 1
+                swap = result.replace
+                drop = [swap["index"]] if swap else []
+                add = list(result.suggested)
+            elif result.verdict != "effect_found" and result.not_needed:
+                # backward elimination: the least needed of the effects the others make
+                # unnecessary comes out, the rest re-estimated; then diagnose again
+                least = min(result.not_needed, key=lambda d: d["chi2_rise"] / d["needed"])
+                swap, drop, add = None, [least["index"]], []
+            else:
                 break
-            swap = result.replace
-            outcome = update(model, measured, list(result.suggested), **noise,
-                             drop=[swap["index"]] if swap else ())
-            model, fit = outcome.model, outcome.fit
-            if swap:
-                row.setdefault("dropped", []).append(swap["effect"])
-            row["added"] += list(result.suggested)
-            result = diagnose(model, measured, **noise)
+            outcome = update(model, measured, add, **noise, drop=drop)
+            if _state(outcome.model) in seen:   # back where the loop was: stop there
+                break
+            again = diagnose(outcome.model, measured, **noise)
+            if not add and result.verdict == "consistent" and again.verdict != "consistent":
+                # needed for consistency though not for significance: it stays
+                row["kept"] = least["effect"]
+                break
+            model, fit, result = outcome.model, outcome.fit, again
+            seen.add(_state(model))
+            if drop:
+                row.setdefault("dropped", []).append(
+                    swap["effect"] if swap else least["effect"])
+            row["added"] += add
             row["verdicts"].append(result.verdict)
         row["final_chi2_per_residual"] = result.current.chi2_per_residual
         row["remaining"] = getattr(result, "remaining", None)
@@ -166,6 +188,13 @@ def run_case(case) -> dict:
     if row["exit"]:
         row.update(class_right=False, verdict_right=False, false_alarm=_no_local(case))
     return row
+
+
+def _state(model) -> tuple:
+    """The model's effects by name and place (to the millimetre): a loop that comes back to
+    a state it has been in stops."""
+    return tuple(sorted((e.name, round(float(e.parameters.get("position", -1)), 3))
+                        for e in model.effects))
 
 
 def _candidates_of(result) -> list:
