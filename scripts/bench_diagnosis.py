@@ -139,37 +139,7 @@ def run_case(case) -> dict:
         row["verdicts"].append(result.verdict)
         row["first_chi2_per_residual"] = result.baseline.chi2_per_residual
         row["first_candidates"] = _candidates_of(result)
-        fit = None
-        adds = 0
-        seen = {_state(model)}
-        while True:
-            if result.verdict == "effect_found" and adds < ROUNDS:
-                adds += 1
-                swap = result.replace
-                drop = [swap["index"]] if swap else []
-                add = list(result.suggested)
-            elif result.verdict != "effect_found" and result.not_needed:
-                # backward elimination: the least needed of the effects the others make
-                # unnecessary comes out, the rest re-estimated; then diagnose again
-                least = min(result.not_needed, key=lambda d: d["chi2_rise"] / d["needed"])
-                swap, drop, add = None, [least["index"]], []
-            else:
-                break
-            outcome = update(model, measured, add, **noise, drop=drop)
-            if _state(outcome.model) in seen:   # back where the loop was: stop there
-                break
-            again = diagnose(outcome.model, measured, **noise)
-            if not add and result.verdict == "consistent" and again.verdict != "consistent":
-                # needed for consistency though not for significance: it stays
-                row["kept"] = least["effect"]
-                break
-            model, fit, result = outcome.model, outcome.fit, again
-            seen.add(_state(model))
-            if drop:
-                row.setdefault("dropped", []).append(
-                    swap["effect"] if swap else least["effect"])
-            row["added"] += add
-            row["verdicts"].append(result.verdict)
+        model, fit, result = follow(model, measured, noise, result, row)
         row["final_chi2_per_residual"] = result.current.chi2_per_residual
         row["remaining"] = getattr(result, "remaining", None)
         # present effects the last diagnosis says the others make unnecessary (step 9)
@@ -188,6 +158,45 @@ def run_case(case) -> dict:
     if row["exit"]:
         row.update(class_right=False, verdict_right=False, false_alarm=_no_local(case))
     return row
+
+
+def follow(model, measured, noise, result, row):
+    """The loop a user runs after a first diagnosis ``result`` (module docstring): adds what
+    each diagnosis suggests, takes out what step 9 says is not needed; records verdicts,
+    additions, what was taken out (``dropped``) or kept (``kept``) in ``row``.  Returns the
+    final (model, fit of its effects or None, diagnosis)."""
+    fit = None
+    adds = 0
+    seen = {_state(model)}
+    while True:
+        if result.verdict == "effect_found" and adds < ROUNDS:
+            adds += 1
+            swap = result.replace
+            drop = [swap["index"]] if swap else []
+            add = list(result.suggested)
+        elif result.verdict != "effect_found" and result.not_needed:
+            # backward elimination: the least needed of the effects the others make
+            # unnecessary comes out, the rest re-estimated; then diagnose again
+            least = min(result.not_needed, key=lambda d: d["chi2_rise"] / d["needed"])
+            swap, drop, add = None, [least["index"]], []
+        else:
+            break
+        outcome = update(model, measured, add, **noise, drop=drop)
+        if _state(outcome.model) in seen:   # back where the loop was: stop there
+            break
+        again = diagnose(outcome.model, measured, **noise)
+        if not add and result.verdict == "consistent" and again.verdict != "consistent":
+            # needed for consistency though not for significance: it stays
+            row["kept"] = least["effect"]
+            break
+        model, fit, result = outcome.model, outcome.fit, again
+        seen.add(_state(model))
+        if drop:
+            row.setdefault("dropped", []).append(
+                swap["effect"] if swap else least["effect"])
+        row["added"] += add
+        row["verdicts"].append(result.verdict)
+    return model, fit, result
 
 
 def _state(model) -> tuple:

@@ -104,3 +104,32 @@ def test_the_campaign_scores_one_zone_over_two_close_cracks_and_ignores_what_dat
     found = [("point_mass", {"position": 0.2, "mass": 0.07})]
     assert _scored([mass, material], found, marginal=(2.6e4, 0.3))["verdict_right"]
     assert not _scored([mass, material], found, marginal=(2.6e4, 800.0))["verdict_right"]
+
+
+def test_the_users_loop_takes_out_what_the_others_make_unnecessary():
+    """The campaign's loop (``bench_diagnosis.follow``) on a model holding the crack the
+    data have (reference beam, Christides–Barr at 0.19 m) and a point mass they do not:
+    the diagnosis adds nothing and lists the mass as not needed; the loop takes it out,
+    diagnoses again and ends consistent with the crack alone, where it was."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import bench_diagnosis
+
+    from gfe_opt.diagnosis import update
+    from gfe_opt.model import Effect
+
+    from .reference import christides_barr
+    from .test_diagnosis import NOISE, reference_data
+
+    measured = reference_data(rigidity=christides_barr(0.19, 0.5))
+    cracked = update(make_model(), measured, ["crack"], **NOISE).model
+    model = cracked.with_effects([*cracked.effects,
+                                  Effect("point_mass", {"position": 0.4, "mass": 0.05})])
+    first = diagnose(model, measured, **NOISE)
+    assert first.verdict == "consistent" and first.not_needed
+    row = {"verdicts": [first.verdict], "added": []}
+    final, fit, last = bench_diagnosis.follow(model, measured, NOISE, first, row)
+    assert row["dropped"] == ["point_mass"] and row["added"] == [] and "kept" not in row
+    assert [e.name for e in final.effects] == ["crack"]
+    assert abs(final.effects[0].parameters["position"] - 0.19) < 0.02 * L
+    assert last.verdict == "consistent" and last.not_needed == []
+    assert row["verdicts"] == ["consistent", "consistent"]
