@@ -286,9 +286,19 @@ def cmd_modes(args) -> int:
     from .model import load_model
 
     check_output_path(args.out, args.force, (args.model,), kind="modes")
-    model = load_model(args.model)
+    model = load_model(args.model, frames=True)
     if args.modes < 1:
         raise GfeInputError("--modes", None, f"must be >= 1, got {args.modes}")
+    if model.kind == "frame":
+        from .frame import write_frame_modes
+
+        written, sensors, rigid = write_frame_modes(model, args.modes, args.out,
+                                                    force=args.force, protect=(args.model,))
+        print(f"{written} modes of {model.name} ({len(model.members)} members, "
+              f"{model.n_elements} elements) at {sensors} sensors written to {args.out}")
+        if rigid:
+            print(f"note: {rigid} rigid-body mode{'s' if rigid > 1 else ''} (0 Hz) left out")
+        return 0
     from .inputs import MAX_SENSORS
 
     if len(model.nodes) > MAX_SENSORS + 2:  # a value at every node (supports may drop two)

@@ -150,8 +150,11 @@ class Model:
 # -------------------------------------------------------------------------------------------
 
 
-def load_model(path) -> Model:
-    """Read and validate a model TOML file; raises :class:`GfeInputError` on bad input."""
+def load_model(path, *, frames: bool = False) -> Model:
+    """Read and validate a model TOML file; raises :class:`GfeInputError` on bad input.
+    A plane frame (``kind = "frame"``) is read only where ``frames`` says the caller takes
+    one (a :class:`~gfe_opt.frame.FrameModel`); elsewhere it is an input error saying what
+    frames can do so far."""
     from .inputs import read_text
 
     where = str(path)
@@ -162,6 +165,14 @@ def load_model(path) -> Model:
         raise GfeInputError(where, None, f"not valid TOML ({exc})") from None
     except RecursionError:
         raise GfeInputError(where, None, "not valid TOML (nested too deeply)") from None
+    if isinstance(data, dict) and data.get("kind") == "frame":
+        if not frames:
+            raise GfeInputError(where, "kind", "a plane frame: gfe-opt computes its modes so far "
+                                "(gfe-opt modes); compare, diagnose, update and batch take "
+                                "beams and bars")
+        from .frame import frame_from_dict
+
+        return frame_from_dict(data, where)
     return model_from_dict(data, where)
 
 

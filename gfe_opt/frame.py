@@ -1,0 +1,545 @@
+r"""Plane frames of beam–bar members (issue 24, first part): model files, assembly, modes.
+
+A member is the paper's generic beam element (bending, eq. 11 with the Euler–Bernoulli
+parameters k_ww = 12EI, k_wθ = 6EI, k_θθ = 4EI, or those of the exact static element of
+EI(x) where a crack changes it) together with its generic bar element (axial, eq. 2 with
+k = EA), in the member's own axes; rotated into global axes by
+:math:`T = \mathrm{diag}(R, R)`, :math:`R = [[c, s, 0], [-s, c, 0], [0, 0, 1]]`.  Consistent
+masses (bar β = 1/6, beam m11 = 13/35 ...).  Every node has three DOFs (u, v, θ) in global
+axes; members meeting at a joint share them (a rigid joint) unless a ``joint_spring`` gives
+the member's end its own rotation, tied to the joint's by ½ k (θ_m − θ_J)².
+
+Model file (``kind = "frame"``; README "Plane frames")::
+
+    name = "portal"
+    kind = "frame"
+    [material]   E, rho, nu          (the default of every member)
+    [section]    shape = "rectangle", b, h  (h in the frame's plane) | A, I [, h]
+    [[nodes]]    id, x, y            (m)
+    [[members]]  id, from, to, elements [, [members.material], [members.section]]
+    [[supports]] node, type = "clamped" | "pinned" | "roller-x" | "roller-y"
+    [[effects]]  effect = "crack": member, position (m from its start node), depth_ratio
+                 effect = "joint_spring": node, member, stiffness (N m/rad)
+
+So far frames have modes (:func:`frame_modes`, ``gfe-opt modes``); comparing, diagnosing
+and updating them are the next parts of the issue.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import elements as el
+from .errors import GfeInputError
+
+SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
+FRAME_EFFECTS = ("crack", "joint_spring")
+#: a crack's Christides–Barr disturbance is below 1e-15 beyond this many decay lengths
+CRACK_REACH = 18.0
+
+
+@dataclass(frozen=True)
+class Member:
+    """One straight member: its end nodes (ids), mesh and section."""
+
+    id: str
+    start: str
+    end: str
+    elements: int
+    E: float
+    rho: float
+    nu: float
+    area: float
+    inertia: float
+    depth: float | None = None
+
+
+@dataclass(frozen=True)
+class FrameModel:
+    """A plane frame: named nodes (x, y in m), members between them, supports, effects
+    (dicts as in the file, validated)."""
+
+    name: str
+    nodes: dict
+    members: tuple
+    supports: tuple          # (node id, type)
+    effects: tuple = ()      # dicts: {"effect": ..., ...}
+    source: str | None = None
+    kind: str = field(default="frame")
+
+    def member(self, member_id: str) -> Member:
+        return next(m for m in self.members if m.id == member_id)
+
+    def member_length(self, member: Member) -> float:
+        (x0, y0), (x1, y1) = self.nodes[member.start], self.nodes[member.end]
+        return math.hypot(x1 - x0, y1 - y0)
+
+    @property
+    def n_elements(self) -> int:
+        return sum(m.elements for m in self.members)
+
+
+# ------------------------------------------------------------------------------------------
+# reading
+# ------------------------------------------------------------------------------------------
+
+
+def frame_from_dict(data: dict, where: str = "model") -> FrameModel:
+    """A :class:`FrameModel` from the parsed TOML mapping; :class:`GfeInputError` (one line:
+    file, key, what is wrong) on bad input."""
+    from .effects.base import no_unknown
+    from .model import _number, _table
+
+    no_unknown(data, {"name", "kind", "material", "section", "nodes", "members", "supports",
+                      "effects"}, where, "")
+    name = data.get("name", where.rsplit("/", 1)[-1].rsplit(".", 1)[0])
+    if not isinstance(name, str):
+        raise GfeInputError(where, "name", f"must be a string, got {name!r}")
+    material = _material(_table(data, "material", where), where, "material.", None)
+    section = _section(_table(data, "section", where), where, "section.", None)
+
+    nodes = {}
+    for i, raw in enumerate(_array(data, "nodes", where)):
+        key = f"nodes[{i}]."
+        no_unknown(raw, {"id", "x", "y"}, where, key)
+        node_id = _ident(raw, "id", where, key)
+        if node_id in nodes:
+            raise GfeInputError(where, key + "id", f"{node_id!r} is used by another node")
+        nodes[node_id] = (_number(raw, "x", where, prefix=key), _number(raw, "y", where,
+                                                                        prefix=key))
+    if len(nodes) < 2:
+        raise GfeInputError(where, "nodes", "a frame needs at least two nodes")
+
+    from .inputs import MAX_ELEMENTS
+
+    members, ids = [], set()
+    for i, raw in enumerate(_array(data, "members", where)):
+        key = f"members[{i}]."
+        no_unknown(raw, {"id", "from", "to", "elements", "material", "section"}, where, key)
+        member_id = _ident(raw, "id", where, key)
+        if member_id in ids:
+            raise GfeInputError(where, key + "id", f"{member_id!r} is used by another member")
+        ids.add(member_id)
+        ends = [_ident(raw, k, where, key) for k in ("from", "to")]
+        for k, node in zip(("from", "to"), ends):
+            if node not in nodes:
+                raise GfeInputError(where, key + k, f"no node {node!r} (nodes: "
+                                    f"{', '.join(nodes)})")
+        (x0, y0), (x1, y1) = nodes[ends[0]], nodes[ends[1]]
+        length = math.hypot(x1 - x0, y1 - y0)
+        if ends[0] == ends[1] or length == 0.0:
+            raise GfeInputError(where, key + "to", "the member's ends are at the same place")
+        n = raw.get("elements")
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise GfeInputError(where, key + "elements", f"must be an integer >= 1, got {n!r}")
+        if n > MAX_ELEMENTS["beam"]:
+            raise GfeInputError(where, key + "elements", f"{n} is above "
+                                f"{MAX_ELEMENTS['beam']}, the finest beam mesh gfe-opt solves")
+        mat = _material(raw.get("material", {}), where, key + "material.", material)
+        sec = _section(raw.get("section", {}), where, key + "section.", section)
+        if mat is None:
+            raise GfeInputError(where, key + "material", "no material: give [material] or "
+                                "[members.material]")
+        if sec is None:
+            raise GfeInputError(where, key + "section", "no section: give [section] or "
+                                "[members.section]")
+        _check_fits(sec, length, where, key + "section")
+        members.append(Member(member_id, ends[0], ends[1], n, *mat, *sec))
+    if not members:
+        raise GfeInputError(where, "members", "a frame needs at least one member")
+    used = {m.start for m in members} | {m.end for m in members}
+    loose = [n for n in nodes if n not in used]
+    if loose:
+        raise GfeInputError(where, "nodes", f"node {loose[0]!r} is on no member")
+
+    supports, held = [], set()
+    for i, raw in enumerate(data.get("supports", []) if isinstance(data.get("supports", []),
+                                                                  list) else [None]):
+        key = f"supports[{i}]."
+        if not isinstance(raw, dict):
+            raise GfeInputError(where, "supports", "must be an array of tables ([[supports]])")
+        no_unknown(raw, {"node", "type"}, where, key)
+        node = _ident(raw, "node", where, key)
+        if node not in nodes:
+            raise GfeInputError(where, key + "node", f"no node {node!r}")
+        if node in held:
+            raise GfeInputError(where, key + "node", f"node {node!r} is supported twice")
+        held.add(node)
+        kind = raw.get("type")
+        if kind not in SUPPORT_TYPES:
+            raise GfeInputError(where, key + "type", f"unknown support {kind!r} (known: "
+                                f"{', '.join(SUPPORT_TYPES)})")
+        supports.append((node, kind))
+
+    model = FrameModel(name=name, nodes=nodes, members=tuple(members),
+                       supports=tuple(supports), source=where)
+    effects = tuple(_effect(model, raw, where, f"effects[{i}].")
+                    for i, raw in enumerate(_array(data, "effects", where, required=False)))
+    return FrameModel(name=name, nodes=nodes, members=tuple(members),
+                      supports=tuple(supports), effects=effects, source=where)
+
+
+def _array(data, key, where, required=True) -> list:
+    raw = data.get(key)
+    if raw is None and not required:
+        return []
+    if not isinstance(raw, list) or not raw or not all(isinstance(r, dict) for r in raw):
+        raise GfeInputError(where, key, f"{'missing: ' if raw is None else ''}must be an array "
+                            f"of tables ([[{key}]])")
+    return raw
+
+
+def _ident(raw, key, where, prefix) -> str:
+    value = raw.get(key)
+    if not isinstance(value, str) or not value:
+        raise GfeInputError(where, prefix + key, f"must be a name (a string), got {value!r}")
+    return value
+
+
+def _material(tbl, where, prefix, default):
+    """(E, rho, nu), each missing key from ``default``; None if neither gives E and rho."""
+    from .effects.base import no_unknown
+    from .model import _number
+
+    if not isinstance(tbl, dict):
+        raise GfeInputError(where, prefix.rstrip("."), "must be a table")
+    no_unknown(tbl, {"E", "rho", "nu"}, where, prefix)
+    base = dict(zip(("E", "rho", "nu"), default)) if default else {"nu": 0.3}
+    if not tbl and default is None:
+        return None
+    out = {**base, **{k: _number(tbl, k, where, positive=k != "nu", prefix=prefix)
+                      for k in tbl}}
+    if "E" not in out or "rho" not in out:
+        missing = "E" if "E" not in out else "rho"
+        raise GfeInputError(where, prefix + missing, "missing")
+    if not 1e7 <= out["E"] <= 1e13:
+        raise GfeInputError(where, prefix + "E", f"{out['E']:g} Pa is outside 1e7..1e13 Pa: "
+                            "give E in Pa (210e9 for steel)")
+    if not 100.0 <= out["rho"] <= 30000.0:
+        raise GfeInputError(where, prefix + "rho", f"{out['rho']:g} kg/m^3 is outside "
+                            "100..30000: give the density in kg/m^3")
+    if not -1.0 < out["nu"] < 0.5:
+        raise GfeInputError(where, prefix + "nu", f"Poisson's ratio must lie in (-1, 0.5), "
+                            f"got {out['nu']}")
+    return out["E"], out["rho"], out["nu"]
+
+
+def _section(tbl, where, prefix, default):
+    """(A, I, h or None); a member's table replaces the default section whole."""
+    from .effects.base import no_unknown
+    from .model import _number
+
+    if not isinstance(tbl, dict):
+        raise GfeInputError(where, prefix.rstrip("."), "must be a table")
+    if not tbl:
+        return default
+    shape = tbl.get("shape")
+    if shape is not None:
+        if shape != "rectangle":
+            raise GfeInputError(where, prefix + "shape", f"unknown shape {shape!r} (known: "
+                                "'rectangle', or give A and I)")
+        no_unknown(tbl, {"shape", "b", "h"}, where, prefix)
+        b = _number(tbl, "b", where, positive=True, prefix=prefix)
+        h = _number(tbl, "h", where, positive=True, prefix=prefix)
+        return b * h, b * h**3 / 12.0, h
+    no_unknown(tbl, {"A", "I", "h"}, where, prefix)
+    h = _number(tbl, "h", where, positive=True, prefix=prefix) if "h" in tbl else None
+    return (_number(tbl, "A", where, positive=True, prefix=prefix),
+            _number(tbl, "I", where, positive=True, prefix=prefix), h)
+
+
+def _check_fits(section, length, where, key) -> None:
+    area, inertia, _ = section
+    size, gyration = math.sqrt(area) / length, math.sqrt(inertia / area) / length
+    if not (1e-5 <= size <= 1.0 and 1e-6 <= gyration <= 1.0):
+        raise GfeInputError(where, key, f"A = {area:g} m^2 and I = {inertia:g} m^4 do not fit "
+                            f"a {length:g} m long member (√A and √(I/A) between 1e-5 and 1 of "
+                            "its length): is the section in metres?")
+
+
+def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
+    """One effect of a frame file, validated: a crack on a member, a joint spring."""
+    from .effects.base import no_unknown
+    from .model import _number
+
+    name = raw.get("effect")
+    if name not in FRAME_EFFECTS:
+        raise GfeInputError(where, prefix + "effect", f"{name!r} is not an effect frames take "
+                            f"yet (known: {', '.join(FRAME_EFFECTS)})")
+    member_id = _ident(raw, "member", where, prefix)
+    if member_id not in {m.id for m in model.members}:
+        raise GfeInputError(where, prefix + "member", f"no member {member_id!r}")
+    member = model.member(member_id)
+    if name == "crack":
+        no_unknown(raw, {"effect", "member", "position", "depth_ratio"}, where, prefix)
+        length = model.member_length(member)
+        x = _number(raw, "position", where, prefix=prefix)
+        if not 0.0 < x < length:
+            raise GfeInputError(where, prefix + "position", f"must lie inside the member "
+                                f"(0, {length:g}) m, got {x:g}")
+        ratio = _number(raw, "depth_ratio", where, prefix=prefix)
+        if not 0.0 < ratio <= 0.95:
+            raise GfeInputError(where, prefix + "depth_ratio", "must lie between 0 and 0.95 "
+                                f"(a/d), got {ratio:g}")
+        if member.depth is None:
+            raise GfeInputError(where, prefix + "effect", "a crack needs the member's section "
+                                "depth h")
+        return {"effect": name, "member": member_id, "position": x, "depth_ratio": ratio}
+    no_unknown(raw, {"effect", "member", "node", "stiffness"}, where, prefix)
+    node = _ident(raw, "node", where, prefix)
+    if node not in (member.start, member.end):
+        raise GfeInputError(where, prefix + "node", f"member {member_id!r} does not end at "
+                            f"node {node!r} (its ends: {member.start}, {member.end})")
+    k = _number(raw, "stiffness", where, positive=True, prefix=prefix)
+    return {"effect": name, "member": member_id, "node": node, "stiffness": k}
+
+
+# ------------------------------------------------------------------------------------------
+# mesh and matrices
+# ------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FrameMesh:
+    """Mesh nodes (global x, y), elements (member index, the DOFs of their two ends, length,
+    direction cosines), the DOFs of each named node, rotational springs (dof, dof, k)."""
+
+    xy: np.ndarray                  # (n_nodes, 2)
+    element_member: np.ndarray      # (n_el,)
+    element_dofs: np.ndarray        # (n_el, 6): u, v, θ at the start, then at the end
+    element_length: np.ndarray      # (n_el,)
+    cosines: np.ndarray             # (n_el, 2): c, s
+    node_dofs: dict                 # node id -> (u, v, θ)
+    member_nodes: tuple             # per member: mesh node indices along it
+    springs: tuple                  # (θ dof, θ dof, k)
+    n_dof: int
+    constrained: np.ndarray
+
+
+def frame_mesh(model: FrameModel) -> FrameMesh:
+    """The mesh: joints first (in file order), then each member's interior nodes; three DOFs
+    a node, then one extra rotation per member end that a joint spring frees."""
+    ids = list(model.nodes)
+    xy = [model.nodes[i] for i in ids]
+    member_nodes = []
+    for m in model.members:
+        (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
+        t = np.arange(1, m.elements) / m.elements
+        first = len(xy)
+        xy += [(x0 + s * (x1 - x0), y0 + s * (y1 - y0)) for s in t]
+        member_nodes.append([ids.index(m.start), *range(first, first + m.elements - 1),
+                             ids.index(m.end)])
+    n_nodes = len(xy)
+    dofs = np.arange(3 * n_nodes).reshape(n_nodes, 3)
+    n_dof = 3 * n_nodes
+    springs = []
+    end_theta = {}
+    for e in model.effects:
+        if e["effect"] == "joint_spring":
+            joint = ids.index(e["node"])
+            end_theta[(e["member"], e["node"])] = n_dof
+            springs.append((int(dofs[joint, 2]), n_dof, float(e["stiffness"])))
+            n_dof += 1
+    el_member, el_dofs, el_len, cos = [], [], [], []
+    for k, (m, nodes) in enumerate(zip(model.members, member_nodes)):
+        (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
+        length = math.hypot(x1 - x0, y1 - y0)
+        c, s = (x1 - x0) / length, (y1 - y0) / length
+        for j in range(m.elements):
+            a, b = dofs[nodes[j]].copy(), dofs[nodes[j + 1]].copy()
+            if j == 0 and (m.id, m.start) in end_theta:
+                a[2] = end_theta[(m.id, m.start)]
+            if j == m.elements - 1 and (m.id, m.end) in end_theta:
+                b[2] = end_theta[(m.id, m.end)]
+            el_member.append(k)
+            el_dofs.append(np.concatenate([a, b]))
+            el_len.append(length / m.elements)
+            cos.append((c, s))
+    fixed = [int(dofs[ids.index(node), d]) for node, kind in model.supports
+             for d in SUPPORT_TYPES[kind]]
+    return FrameMesh(xy=np.array(xy, dtype=float), element_member=np.array(el_member),
+                     element_dofs=np.array(el_dofs), element_length=np.array(el_len),
+                     cosines=np.array(cos), node_dofs={i: tuple(int(d) for d in dofs[n])
+                                                       for n, i in enumerate(ids)},
+                     member_nodes=tuple(member_nodes), springs=tuple(springs), n_dof=n_dof,
+                     constrained=np.array(sorted(set(fixed)), dtype=int))
+
+
+def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
+    """(n_el, 3): k_ww, k_wθ, k_θθ of each element [N m²] (eq. 11): Euler–Bernoulli, or
+    the exact static element of EI(x) where a crack's disturbance reaches."""
+    EI = np.array([model.members[k].E * model.members[k].inertia
+                   for k in mesh.element_member])
+    out = np.stack([12.0 * EI, 6.0 * EI, 4.0 * EI], axis=1)
+    for k, member in enumerate(model.members):
+        cracks = [(e["position"], e["depth_ratio"]) for e in model.effects
+                  if e["effect"] == "crack" and e["member"] == member.id]
+        if not cracks:
+            continue
+        half = member.depth / 2.0
+        decay = half / (2.0 * el.SHEN_PIERRE_GAMMA)
+        ei0 = member.E * member.inertia
+        L = model.member_length(member) / member.elements
+        first = int(np.flatnonzero(mesh.element_member == k)[0])
+
+        def rigidity(x, cracks=cracks, half=half, ei0=ei0):
+            q = np.ones_like(np.asarray(x, dtype=float))
+            for x_c, ratio in cracks:
+                q = q * el.christides_barr_q(x, x_c, ratio, half)
+            return ei0 * q
+
+        reached = set()
+        for x_c, _ in cracks:
+            lo = max(int((x_c - CRACK_REACH * decay) // L), 0)
+            hi = min(int((x_c + CRACK_REACH * decay) // L) + 1, member.elements)
+            reached.update(range(lo, hi))
+        for j in sorted(reached):
+            x0 = j * L
+            inside = tuple(x_c for x_c, _ in cracks if x0 < x_c < x0 + L)
+            out[first + j] = el.beam_stiffness_from_flexibility(
+                rigidity, x0, L, breakpoints=inside, refine_scale=decay)
+    return out
+
+
+def element_matrices(model: FrameModel, mesh: FrameMesh):
+    """(K_e, M_e), each (n_el, 6, 6) in global axes: bar ⊕ beam in the member's axes,
+    rotated by T = diag(R, R)."""
+    n = mesh.element_length.size
+    L = mesh.element_length
+    EA = np.array([model.members[k].E * model.members[k].area for k in mesh.element_member])
+    rhoA = np.array([model.members[k].rho * model.members[k].area
+                     for k in mesh.element_member])
+    local_k = np.zeros((n, 6, 6))
+    local_m = np.zeros((n, 6, 6))
+    axial, bend = [0, 3], [1, 2, 4, 5]
+    local_k[np.ix_(range(n), axial, axial)] = el.generic_bar_stiffness(EA, L)
+    local_m[np.ix_(range(n), axial, axial)] = el.generic_bar_mass(
+        rhoA, L, np.full(n, el.BAR_MASS_BETA["consistent"]))
+    p = bending_parameters(model, mesh)
+    P = np.stack([np.stack([p[:, 0], p[:, 1]], -1), np.stack([p[:, 1], p[:, 2]], -1)], -2)
+    H = el.BEAM_DEFORMATION_H
+    scaling = el.beam_dof_scaling(L)                     # (n, 4)
+    scaled = np.einsum("ji,ejk,kl->eil", H, P, H) / L[:, None, None] ** 3
+    local_k[np.ix_(range(n), bend, bend)] = scaled * scaling[:, :, None] * scaling[:, None, :]
+    mass = (rhoA * L)[:, None, None] * el.symmetric_beam_mass(
+        **{k: np.full(n, v) for k, v in el.CONSISTENT_BEAM_MASS.items()})
+    local_m[np.ix_(range(n), bend, bend)] = mass * scaling[:, :, None] * scaling[:, None, :]
+    c, s = mesh.cosines[:, 0], mesh.cosines[:, 1]
+    T = np.zeros((n, 6, 6))
+    for o in (0, 3):
+        T[:, o, o], T[:, o, o + 1] = c, s
+        T[:, o + 1, o], T[:, o + 1, o + 1] = -s, c
+        T[:, o + 2, o + 2] = 1.0
+    Tt = np.swapaxes(T, 1, 2)
+    return Tt @ local_k @ T, Tt @ local_m @ T
+
+
+def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
+    """Global (K, M), sparse, all DOFs (supports not applied)."""
+    mesh = frame_mesh(model) if mesh is None else mesh
+    Ke, Me = element_matrices(model, mesh)
+    rows = np.repeat(mesh.element_dofs, 6, axis=1).ravel()
+    cols = np.tile(mesh.element_dofs, (1, 6)).ravel()
+    shape = (mesh.n_dof, mesh.n_dof)
+    K = sp.coo_matrix((Ke.ravel(), (rows, cols)), shape=shape).tocsr()
+    M = sp.coo_matrix((Me.ravel(), (rows, cols)), shape=shape).tocsr()
+    for a, b, k in mesh.springs:
+        K = K + sp.csr_matrix(([k, -k, -k, k], ([a, a, b, b], [a, b, a, b])), shape=shape)
+    return K, M
+
+
+def frame_modes(model: FrameModel, n_modes: int):
+    """The lowest ``n_modes`` modes (:class:`~gfe_opt.modal.Modes`; shapes over all DOFs,
+    zero at the supports), rigid-body modes (0 Hz) included; checked as the beam's direct
+    route is (the relative residual of every elastic mode)."""
+    from .errors import GfeSolverError
+    from .modal import RESIDUAL_TOLERANCE, Modes, _residual, solve_modes
+
+    mesh = frame_mesh(model)
+    K, M = frame_matrices(model, mesh)
+    free = np.setdiff1d(np.arange(mesh.n_dof), mesh.constrained)
+    if not 1 <= n_modes <= free.size - 1:
+        raise GfeInputError(model.source, "modes", f"the frame has {free.size} free DOFs: "
+                            f"ask for 1 to {free.size - 1} modes, got {n_modes}")
+    ref = min(m.E * m.inertia / (m.rho * m.area * model.member_length(m) ** 4)
+              for m in model.members)
+    modes = solve_modes(K, M, n_modes, mesh.constrained, ref)
+    rigid = modes.frequencies_hz == 0
+    lam = np.where(rigid, 0.0, strain_energy(model, mesh, modes.shapes)
+                   / np.einsum("ij,ij->j", modes.shapes, M @ modes.shapes))
+    worst = _residual(K, M, modes.shapes, lam, free)
+    if worst > RESIDUAL_TOLERANCE:
+        raise GfeSolverError(f"modal solve failed its check: relative residual {worst:.2g}")
+    return Modes(frequencies_hz=np.sqrt(lam) / (2 * np.pi), shapes=modes.shapes)
+
+
+def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:
+    """2 × the strain energy of each shape (columns), summed element by element from the
+    element deformations in the member's axes (axial u₂ − u₁; bending d = H [v₁, Lθ₁, v₂,
+    Lθ₂]), so that no large stiffness entries cancel (as the beam's Rayleigh quotients,
+    :mod:`gfe_opt.modal`): the axial stiffness of a fine mesh is (A L²/I) N² times the
+    bending one, and eigenvalues from the solver alone lose that factor times eps."""
+    u = shapes[mesh.element_dofs]                         # (n_el, 6, modes)
+    c, s = mesh.cosines[:, 0, None], mesh.cosines[:, 1, None]
+    L = mesh.element_length[:, None]
+    axial = (c * (u[:, 3] - u[:, 0]) + s * (u[:, 4] - u[:, 1]))
+    v1, v2 = -s * u[:, 0] + c * u[:, 1], -s * u[:, 3] + c * u[:, 4]
+    d1 = v1 - v2 + L * u[:, 5]                            # d = H [w1, Lθ1, w2, Lθ2]
+    d2 = L * (u[:, 2] - u[:, 5])
+    p = bending_parameters(model, mesh)
+    EA = np.array([model.members[k].E * model.members[k].area for k in mesh.element_member])
+    energy = (EA[:, None] / L) * axial**2 + (p[:, 0, None] * d1**2 + 2 * p[:, 1, None] * d1 * d2
+                                             + p[:, 2, None] * d2**2) / L**3
+    total = energy.sum(axis=0)
+    for a, b, k in mesh.springs:
+        total = total + k * (shapes[a] - shapes[b]) ** 2
+    return total
+
+
+def mesh_sensors(model: FrameModel, mesh: FrameMesh) -> list[tuple[dict, int]]:
+    """Every free translation of the mesh as a sensor of the frame measured-data contract
+    (``{"node": id, "direction": "x"}`` at named nodes, ``{"member": id, "position": m,
+    "direction": "y"}`` between them) with its DOF."""
+    out = []
+    fixed = set(mesh.constrained.tolist())
+    for node, (u, v, _) in mesh.node_dofs.items():
+        out += [({"node": node, "direction": d}, dof) for d, dof in (("x", u), ("y", v))
+                if dof not in fixed]
+    for member, nodes in zip(model.members, mesh.member_nodes):
+        step = model.member_length(member) / member.elements
+        for j, n in enumerate(nodes[1:-1], start=1):
+            out += [({"member": member.id, "position": round(j * step, 12), "direction": d},
+                     3 * n + k) for k, d in ((0, "x"), (1, "y"))]
+    return out
+
+
+def write_frame_modes(model: FrameModel, n_modes: int, path, *, force: bool = False,
+                      protect=()) -> tuple[int, int, int]:
+    """The frame's elastic modes at every free mesh translation, written as frame measured
+    data (JSON: ``{"sensors": [...], "modes": [{"frequency": Hz, "shape": [...]}]}``),
+    atomically.  Returns (elastic modes written, sensors, rigid-body modes left out)."""
+    import json
+
+    from .outputs import atomic_write, check_output_path
+
+    path = check_output_path(path, force, protect, kind="modes")
+    if path.suffix.lower() != ".json":
+        raise GfeInputError(str(path), None, "a frame's modes are written as .json (the frame "
+                            "measured-data format; CSV and UFF for frames are not there yet)")
+    mesh = frame_mesh(model)
+    free = mesh.n_dof - mesh.constrained.size
+    modes = frame_modes(model, min(n_modes + 3, free - 1))
+    elastic = np.flatnonzero(modes.frequencies_hz > 0)[:n_modes]
+    sensors = mesh_sensors(model, mesh)
+    doc = {"sensors": [s for s, _ in sensors],
+           "modes": [{"frequency": float(modes.frequencies_hz[j]),
+                      "shape": [float(modes.shapes[dof, j]) for _, dof in sensors]}
+                     for j in elastic]}
+    text = json.dumps(doc, indent=1)
+    atomic_write(path, lambda p: p.write_text(text + "\n", encoding="utf-8"), replace=force)
+    rigid = int(np.sum(modes.frequencies_hz[:elastic[0]] == 0)) if elastic.size else 0
+    return elastic.size, len(sensors), rigid

@@ -1,0 +1,114 @@
+r"""Exact natural frequencies of plane frames by the dynamic stiffness method (Euler–Bernoulli
+members with axial motion; Williams & Wittrick), independent of gfe-opt's elements.
+
+Each member's end forces follow from the exact solution of its equations of motion at
+frequency ω: axially u(x) = a cos kx + b sin kx, k = ω √(ρ/E); in bending
+w(x) = c₁ cos βx + c₂ sin βx + c₃ cosh βx + c₄ sinh βx, β⁴ = ρAω²/EI.  The end
+displacements are B c and the end forces F c (F₁ = EI w‴(0), M₁ = −EI w″(0),
+F₂ = −EI w‴(L), M₂ = EI w″(L)), so the member's dynamic stiffness is F B⁻¹; rotated and
+assembled as a stiffness matrix, D(ω) is singular at every natural frequency.  A root is
+found by bisection of the eigenvalue of D(ω) (in a fixed place of the sorted spectrum) that
+crosses zero, in a bracket about an estimate.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+
+SUPPORTS = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
+
+
+def member_dynamic_stiffness(E, rho, A, inertia, L, omega) -> np.ndarray:
+    """(6, 6) dynamic stiffness in the member's axes, DOFs u₁, v₁, θ₁, u₂, v₂, θ₂."""
+    D = np.zeros((6, 6))
+    k = omega * math.sqrt(rho / E)
+    if k * L < 1e-8:
+        axial = E * A / L * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    else:
+        axial = E * A * k / math.sin(k * L) * np.array([[math.cos(k * L), -1.0],
+                                                         [-1.0, math.cos(k * L)]])
+    D[np.ix_([0, 3], [0, 3])] = axial
+    EI = E * inertia
+    beta = (rho * A * omega**2 / EI) ** 0.25
+
+    def derivs(x):
+        """w, w', w'', w''' of the four basis functions at x (rows)."""
+        c, s, ch, sh = math.cos(beta * x), math.sin(beta * x), math.cosh(beta * x), \
+            math.sinh(beta * x)
+        b = beta
+        return np.array([[c, s, ch, sh],
+                         [-b * s, b * c, b * sh, b * ch],
+                         [-b * b * c, -b * b * s, b * b * ch, b * b * sh],
+                         [b**3 * s, -b**3 * c, b**3 * sh, b**3 * ch]])
+
+    d0, d1 = derivs(0.0), derivs(L)
+    B = np.array([d0[0], d0[1], d1[0], d1[1]])
+    F = np.array([EI * d0[3], -EI * d0[2], -EI * d1[3], EI * d1[2]])
+    D[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = F @ np.linalg.inv(B)
+    return D
+
+
+class ExactFrame:
+    """A frame of uniform members: ``nodes`` {id: (x, y)}, ``members`` [(from, to, E, rho,
+    A, I)], ``supports`` {id: type}, ``joint_springs`` [(node, member index, k)]."""
+
+    def __init__(self, nodes, members, supports, joint_springs=()):
+        self.ids = list(nodes)
+        self.nodes = nodes
+        self.members = members
+        n = 3 * len(self.ids)
+        self.end_theta = {}
+        self.springs = []
+        for node, m, k in joint_springs:
+            self.end_theta[(m, node)] = n
+            self.springs.append((3 * self.ids.index(node) + 2, n, k))
+            n += 1
+        self.n = n
+        fixed = {3 * self.ids.index(i) + d for i, t in supports.items() for d in SUPPORTS[t]}
+        self.free = np.array([d for d in range(n) if d not in fixed])
+        E, _, _, inertia = members[0][2:]
+        L = max(self._length(m) for m in members)
+        self.scale = E * inertia / L**3
+
+    def _length(self, m):
+        (x0, y0), (x1, y1) = self.nodes[m[0]], self.nodes[m[1]]
+        return math.hypot(x1 - x0, y1 - y0)
+
+    def matrix(self, omega) -> np.ndarray:
+        D = np.zeros((self.n, self.n))
+        for k, m in enumerate(self.members):
+            a, b, E, rho, A, inertia = m
+            (x0, y0), (x1, y1) = self.nodes[a], self.nodes[b]
+            L = math.hypot(x1 - x0, y1 - y0)
+            c, s = (x1 - x0) / L, (y1 - y0) / L
+            R = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+            T = np.zeros((6, 6))
+            T[:3, :3], T[3:, 3:] = R, R
+            dofs = [3 * self.ids.index(a) + i for i in range(3)] + \
+                   [3 * self.ids.index(b) + i for i in range(3)]
+            if (k, a) in self.end_theta:
+                dofs[2] = self.end_theta[(k, a)]
+            if (k, b) in self.end_theta:
+                dofs[5] = self.end_theta[(k, b)]
+            Dm = member_dynamic_stiffness(E, rho, A, inertia, L, omega)
+            D[np.ix_(dofs, dofs)] += T.T @ Dm @ T
+        for i, j, k in self.springs:
+            D[np.ix_([i, j], [i, j])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
+        return D[np.ix_(self.free, self.free)] / self.scale
+
+    def frequency_near(self, estimate_hz, width=1e-3) -> float:
+        """The natural frequency [Hz] within ``width`` (relative) of ``estimate_hz``."""
+        w0 = 2 * math.pi * estimate_hz
+        lam = np.linalg.eigvalsh(self.matrix(w0))
+        j = int(np.argmin(np.abs(lam)))
+
+        def g(w):
+            return np.linalg.eigvalsh(self.matrix(w))[j]
+
+        lo, hi = w0 * (1 - width), w0 * (1 + width)
+        if g(lo) * g(hi) > 0:
+            raise ValueError(f"no root within {width:g} of {estimate_hz:g} Hz")
+        return brentq(g, lo, hi, xtol=1e-14 * w0, rtol=1e-15) / (2 * math.pi)

@@ -1,0 +1,175 @@
+"""Plane frames (issue 24, first part): frequencies against the exact dynamic stiffness
+solution (tests/frame_reference.py, no gfe-opt element in it), observed convergence rates,
+rigid-body modes, joints, a one-member frame against the beam path, the file contract."""
+
+import json
+import math
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from gfe_opt.errors import GfeInputError
+from gfe_opt.frame import frame_matrices, frame_mesh, frame_modes
+from gfe_opt.modal import model_modes
+from gfe_opt.model import Effect, load_model, model_from_dict
+from gfe_opt.problems import portal_frame, problem_file, three_storey_frame
+
+from .frame_reference import ExactFrame, member_dynamic_stiffness
+
+
+def exact_of(model, joint_springs=()):
+    return ExactFrame(model.nodes, [(m.start, m.end, m.E, m.rho, m.area, m.inertia)
+                                    for m in model.members], dict(model.supports),
+                      joint_springs)
+
+
+def refined(model, n):
+    return replace(model, members=tuple(replace(m, elements=n) for m in model.members))
+
+
+def test_the_reference_member_tends_to_the_static_stiffness():
+    E, rho, A, inertia, L = 210e9, 7850.0, 5e-4, 4e-9, 0.3
+    D = member_dynamic_stiffness(E, rho, A, inertia, L, 1e-2)
+    EI = E * inertia
+    assert D[1, 1] == pytest.approx(12 * EI / L**3, rel=1e-8)
+    assert D[2, 5] == pytest.approx(2 * EI / L, rel=1e-8)
+    assert D[0, 3] == pytest.approx(-E * A / L, rel=1e-8)
+
+
+@pytest.mark.parametrize("factory", [portal_frame, three_storey_frame])
+def test_converged_frames_match_the_exact_frequencies(factory):
+    fine = frame_modes(factory(64), 6).frequencies_hz
+    exact = np.array([exact_of(factory()).frequency_near(f, 1e-4) for f in fine])
+    assert np.max(np.abs(fine / exact - 1)) < 1e-6
+    shipped = frame_modes(factory(), 6).frequencies_hz
+    assert np.max(np.abs(shipped / exact - 1)) < 3e-5
+
+
+def test_portal_convergence_rates_and_the_textbook_sway_estimate():
+    """Bending modes converge as h⁴ (cubic Hermite, consistent mass); the sway mode, whose
+    beam moves axially, at the linear bar element's h² once bending's error is below it."""
+    exact = np.array([exact_of(portal_frame()).frequency_near(f, 1e-4)
+                      for f in frame_modes(portal_frame(64), 6).frequencies_hz])
+    err = {n: np.abs(frame_modes(portal_frame(n), 6).frequencies_hz / exact - 1)
+           for n in (8, 16, 64, 128)}
+    bending = np.log2(err[8] / err[16])[[1, 3, 5]]
+    assert np.all((3.8 < bending) & (bending < 4.2)), bending
+    assert 1.8 < np.log2(err[64][0] / err[128][0]) < 2.2
+    # sway: k = 24EI/h³ (6ρ+1)/(6ρ+4), m = beam + 13/35 of each column
+    m = portal_frame()
+    col, beam = m.member("left-column"), m.member("beam")
+    h, b = m.member_length(col), m.member_length(beam)
+    r = beam.inertia * h / (col.inertia * b)
+    k = 24 * col.E * col.inertia / h**3 * (6 * r + 1) / (6 * r + 4)
+    mass = beam.rho * beam.area * b + 2 * 13 / 35 * col.rho * col.area * h
+    assert exact[0] == pytest.approx(math.sqrt(k / mass) / (2 * math.pi), rel=0.05)
+
+
+def test_a_free_frame_has_three_rigid_body_modes_in_its_null_space():
+    m = replace(portal_frame(4), supports=())
+    mesh = frame_mesh(m)
+    K, M = frame_matrices(m, mesh)
+    xy = mesh.xy
+    rigid = np.zeros((mesh.n_dof, 3))
+    rigid[0::3, 0] = 1.0                     # translation x
+    rigid[1::3, 1] = 1.0                     # translation y
+    rigid[0::3, 2], rigid[1::3, 2], rigid[2::3, 2] = -xy[:, 1], xy[:, 0], 1.0  # rotation
+    assert np.max(np.abs(K @ rigid)) < 1e-9 * abs(K).max()
+    eig = np.linalg.eigvalsh(K.toarray())
+    assert np.sum(np.abs(eig) < 1e-9 * eig.max()) == 3 and eig.min() > -1e-9 * eig.max()
+    f = frame_modes(m, 5).frequencies_hz
+    assert np.all(f[:3] == 0) and np.all(f[3:] > 1)
+
+
+def test_semi_rigid_joints_against_the_exact_solution_and_their_limits():
+    base = portal_frame(64)
+    k = 200.0   # N m/rad, of the order of the column's 4EI/h = 11 700 / 1: semi-rigid
+    joints = [{"effect": "joint_spring", "member": "beam", "node": n, "stiffness": k}
+              for n in ("B", "C")]
+    soft = replace(base, effects=tuple(joints))
+    f = frame_modes(soft, 6).frequencies_hz
+    beam = [m.id for m in base.members].index("beam")
+    exact = exact_of(base, [("B", beam, k), ("C", beam, k)])
+    assert np.max(np.abs(f / [exact.frequency_near(x, 1e-4) for x in f] - 1)) < 1e-6
+    rigid = frame_modes(base, 6).frequencies_hz
+    assert f[0] < 0.95 * rigid[0]
+    stiff = replace(base, effects=tuple(dict(j, stiffness=1e9) for j in joints))
+    assert np.allclose(frame_modes(stiff, 6).frequencies_hz, rigid, rtol=1e-5)
+
+
+def test_a_one_member_frame_is_the_beam_with_its_crack():
+    """A vertical column clamped at its base is the package's cantilever beam: the same
+    bending frequencies with the same Christides–Barr crack (to 5e-9: the beam integrates
+    the crack's tail away from it by Gauss-8, the frame by the graded rule everywhere)."""
+    col = {"name": "column", "kind": "frame",
+           "material": {"E": 210e9, "rho": 7850.0}, "section": {"shape": "rectangle",
+                                                              "b": 0.05, "h": 0.01},
+           "nodes": [{"id": "A", "x": 0.2, "y": 0.0}, {"id": "B", "x": 0.2, "y": 0.5}],
+           "members": [{"id": "c", "from": "A", "to": "B", "elements": 40}],
+           "supports": [{"node": "A", "type": "clamped"}],
+           "effects": [{"effect": "crack", "member": "c", "position": 0.13,
+                        "depth_ratio": 0.5}]}
+    from gfe_opt.frame import frame_from_dict
+
+    frame = frame_modes(frame_from_dict(col), 8).frequencies_hz
+    beam = model_from_dict({"kind": "beam", "length": 0.5, "elements": 40,
+                            "material": {"E": 210e9, "rho": 7850.0},
+                            "section": {"shape": "rectangle", "b": 0.05, "h": 0.01},
+                            "supports": {"left": "clamped", "right": "free"}})
+    beam = beam.with_effects([Effect("crack", {"position": 0.13, "depth_ratio": 0.5})])
+    bending = model_modes(beam, 5).frequencies_hz
+    uncracked = model_modes(beam.with_effects([]), 1).frequencies_hz[0]
+    assert bending[0] < 0.98 * uncracked          # the crack is there
+    for f in bending:   # the frame has the axial modes besides
+        assert np.min(np.abs(frame / f - 1)) < 2e-8
+
+
+@pytest.mark.parametrize("change, key", [
+    (lambda d: d["members"][0].update({"to": "Z"}), "members[0].to"),
+    (lambda d: d["supports"][0].update({"type": "fixed"}), "supports[0].type"),
+    (lambda d: d["members"][1].update({"elements": 0}), "members[1].elements"),
+    (lambda d: d.update({"effects": [{"effect": "joint_spring", "member": "beam",
+                                      "node": "A", "stiffness": 10.0}]}), "effects[0].node"),
+    (lambda d: d.update({"effects": [{"effect": "point_mass", "member": "beam"}]}),
+     "effects[0].effect"),
+])
+def test_bad_frame_files_are_one_line_naming_the_key(change, key):
+    import tomllib
+
+    from gfe_opt.frame import frame_from_dict
+
+    data = tomllib.loads(problem_file("portal-frame.toml").read_text())
+    change(data)
+    with pytest.raises(GfeInputError) as info:
+        frame_from_dict(data, "portal.toml")
+    assert key in str(info.value) and "\n" not in str(info.value)
+
+
+def test_cli_modes_writes_the_frame_contract_and_other_commands_say_what_frames_can_do(
+        tmp_path):
+    out = tmp_path / "portal-modes.json"
+    model = problem_file("portal-frame.toml")
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "modes", str(model), "--out",
+                          str(out), "--modes", "4"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    doc = json.loads(out.read_text())
+    assert set(doc) == {"sensors", "modes"} and len(doc["modes"]) == 4
+    assert {"node": "B", "direction": "x"} in doc["sensors"]
+    assert {"member": "beam", "position": 0.2, "direction": "y"} in doc["sensors"]
+    assert all(len(m["shape"]) == len(doc["sensors"]) for m in doc["modes"])
+    assert doc["modes"][0]["frequency"] == pytest.approx(74.479366, rel=3e-5)
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", str(model),
+                          str(out)], capture_output=True, text=True)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1 and "frame" in run.stderr
+    again = subprocess.run([sys.executable, "-m", "gfe_opt", "modes", str(model), "--out",
+                            str(out)], capture_output=True, text=True)
+    assert again.returncode == 2 and len(json.loads(out.read_text())["modes"]) == 4
+
+
+def test_a_frame_file_is_refused_where_a_beam_is_expected():
+    with pytest.raises(GfeInputError, match="plane frame"):
+        load_model(problem_file("portal-frame.toml"))
