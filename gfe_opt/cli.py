@@ -260,6 +260,10 @@ def cmd_compare(args) -> int:
     from .text import format_comparison
 
     _check_outputs(args, COMPARE_FIGURES)
+    from .model import load_model
+
+    if load_model(args.model, frames=True).kind == "frame":
+        return _compare_frame(args)
     model, measured = _inputs(args)
     result = compare(model, measured, mac_threshold=args.mac_threshold, noise=args.shape_noise)
     if args.json:
@@ -274,6 +278,30 @@ def cmd_compare(args) -> int:
         _write_outputs(args, _figures(compare_figures, result, model),
                        lambda r: _comparison_report(r, result, model, measured),
                        f"gfe-opt compare: {model.name}")
+    return 0
+
+
+def _compare_frame(args) -> int:
+    """``compare`` on a plane frame: pairs, MAC, frequency errors, the sensors where the
+    shapes differ most (figures and reports for frames are not there yet)."""
+    from .frame_data import compare_frame, load_frame_measured
+    from .model import load_model
+    from .text import format_frame_comparison
+
+    if args.plot or args.report:
+        raise GfeInputError("--plot" if args.plot else "--report", None, "figures and "
+                            "reports for frames are not there yet: use the text or --json")
+    model = load_model(args.model, frames=True)
+    measured = load_frame_measured(args.measured, model)
+    result = compare_frame(model, measured, mac_threshold=args.mac_threshold)
+    if args.json:
+        print(json.dumps(result.to_json(), indent=1))
+    else:
+        shapes = (f"at {len(measured.sensors)} sensors" if measured.shapes is not None
+                  else "(frequencies only)")
+        print(f"{model.name}: frame, {len(model.members)} members, {model.n_elements} "
+              f"elements, {measured.n_modes} measured modes {shapes}")
+        print(format_frame_comparison(result))
     return 0
 
 

@@ -167,9 +167,9 @@ def load_model(path, *, frames: bool = False) -> Model:
         raise GfeInputError(where, None, "not valid TOML (nested too deeply)") from None
     if isinstance(data, dict) and data.get("kind") == "frame":
         if not frames:
-            raise GfeInputError(where, "kind", "a plane frame: gfe-opt computes its modes so far "
-                                "(gfe-opt modes); compare, diagnose, update and batch take "
-                                "beams and bars")
+            raise GfeInputError(where, "kind", "a plane frame: gfe-opt computes its modes and "
+                                "compares them with a test so far (gfe-opt modes, gfe-opt "
+                                "compare); diagnose, update, batch and demo take beams and bars")
         from .frame import frame_from_dict
 
         return frame_from_dict(data, where)

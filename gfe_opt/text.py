@@ -86,6 +86,29 @@ def format_comparison(result, length: float) -> str:
     return "\n".join(lines)
 
 
+def format_frame_comparison(result) -> str:
+    """Paired modes of a frame and the sensors where the measured shapes differ most."""
+    from .frame_data import sensor_label
+
+    lines = [f"{'mode':>4}  {'f_test [Hz]':>12}  {'f_model [Hz]':>12}  {'Δf %':>8}  {'MAC':>6}"]
+    for p in result.pairs:
+        lines.append(f"{p.test_mode:>4}  {p.test_hz:12.2f}  {p.model_hz:12.2f}  "
+                     f"{p.error_pct:+8.2f}  {_mac(p.mac, 6, 3)}")
+    mac = "" if result.mac_mean is None else f", mean MAC {result.mac_mean:.3f}"
+    lines.append(f"frequency error (rms) {result.freq_error_rms_pct:.2f} %{mac}")
+    places = result.failure_places()
+    if result.residual is not None and not places:
+        lines += ["", "the model reproduces the measured shapes (residual at rounding level)"]
+    if places:
+        top = float(result.residual.max())
+        lines += ["", "the shapes differ most at (rms over the pairs of the shape residual, "
+                  "in each mode's largest amplitude):"]
+        lines += [f"  {sensor_label(s)}: {rel * top:.2g} ({100 * rel:.0f} % of the largest)"
+                  for s, rel in places]
+    lines.extend(f"note: {n}" for n in result.notes)
+    return "\n".join(lines)
+
+
 def format_diagnosis(result, model) -> str:
     """The ranking, the verdict in words, the effect found ± its uncertainty, what the
     generic-element update shows and the noise the data imply."""

@@ -53,10 +53,12 @@ def member_dynamic_stiffness(E, rho, A, inertia, L, omega) -> np.ndarray:
 
 class ExactFrame:
     """A frame of uniform members: ``nodes`` {id: (x, y)}, ``members`` [(from, to, E, rho,
-    A, I)], ``supports`` {id: type}, ``joint_springs`` [(node, member index, k)]."""
+    A, I)], ``supports`` {id: type}, ``joint_springs`` [(node, member index, k)],
+    ``member_ids`` the members' names (for sensors on them)."""
 
-    def __init__(self, nodes, members, supports, joint_springs=()):
+    def __init__(self, nodes, members, supports, joint_springs=(), member_ids=None):
         self.ids = list(nodes)
+        self.member_ids = list(member_ids or range(len(members)))
         self.nodes = nodes
         self.members = members
         n = 3 * len(self.ids)
@@ -112,3 +114,60 @@ class ExactFrame:
         if g(lo) * g(hi) > 0:
             raise ValueError(f"no root within {width:g} of {estimate_hz:g} Hz")
         return brentq(g, lo, hi, xtol=1e-14 * w0, rtol=1e-15) / (2 * math.pi)
+
+    def _member_axes(self, k):
+        a, b = self.members[k][:2]
+        (x0, y0), (x1, y1) = self.nodes[a], self.nodes[b]
+        L = math.hypot(x1 - x0, y1 - y0)
+        return L, (x1 - x0) / L, (y1 - y0) / L
+
+    def mode_shape(self, frequency_hz, sensors) -> np.ndarray:
+        """The exact mode at a natural frequency, read by ``sensors`` (the frame measured-data
+        contract: a node, or a member and position; direction "x", "y" or degrees): the
+        joint displacements from the null vector of D(ω), each member's interior from its
+        own exact solution between them."""
+        w = 2 * math.pi * frequency_hz
+        _, _, vt = np.linalg.svd(self.matrix(w))
+        full = np.zeros(self.n)
+        full[self.free] = vt[-1]
+        out = []
+        for s in sensors:
+            d = s["direction"]
+            angle = math.radians({"x": 0.0, "y": 90.0}.get(d, d) if isinstance(d, str) else d)
+            direction = np.array([math.cos(angle), math.sin(angle)])
+            if "node" in s:
+                i = 3 * self.ids.index(s["node"])
+                out.append(direction @ full[i:i + 2])
+                continue
+            k = self.member_ids.index(s["member"])
+            a, b, E, rho, A, inertia = self.members[k]
+            L, c, sn = self._member_axes(k)
+            R = np.array([[c, sn], [-sn, c]])
+            dofs = [3 * self.ids.index(a) + i for i in range(3)] + \
+                   [3 * self.ids.index(b) + i for i in range(3)]
+            if (k, a) in self.end_theta:
+                dofs[2] = self.end_theta[(k, a)]
+            if (k, b) in self.end_theta:
+                dofs[5] = self.end_theta[(k, b)]
+            g = full[dofs]
+            u1, v1 = R @ g[0:2]
+            u2, v2 = R @ g[3:5]
+            x = s["position"]
+            ka = w * math.sqrt(rho / E)
+            axial = (u1 * math.sin(ka * (L - x)) + u2 * math.sin(ka * x)) / math.sin(ka * L)
+            beta = (rho * A * w**2 / (E * inertia)) ** 0.25
+
+            B = np.array([_basis(beta, 0, 0), _basis(beta, 0, 1), _basis(beta, L, 0),
+                          _basis(beta, L, 1)])
+            coef = np.linalg.solve(B, [v1, g[2], v2, g[5]])
+            transverse = _basis(beta, x, 0) @ coef
+            out.append(direction @ (R.T @ np.array([axial, transverse])))
+        return np.array(out)
+
+
+def _basis(beta, t, order):
+    """cos βt, sin βt, cosh βt, sinh βt (order 0) or their derivatives (order 1)."""
+    f = [math.cos(beta * t), math.sin(beta * t), math.cosh(beta * t), math.sinh(beta * t)]
+    if order == 0:
+        return np.array(f)
+    return beta * np.array([-f[1], f[0], f[3], f[2]])

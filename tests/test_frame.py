@@ -23,7 +23,7 @@ from .frame_reference import ExactFrame, member_dynamic_stiffness
 def exact_of(model, joint_springs=()):
     return ExactFrame(model.nodes, [(m.start, m.end, m.E, m.rho, m.area, m.inertia)
                                     for m in model.members], dict(model.supports),
-                      joint_springs)
+                      joint_springs, [m.id for m in model.members])
 
 
 def refined(model, n):
@@ -148,7 +148,7 @@ def test_bad_frame_files_are_one_line_naming_the_key(change, key):
     assert key in str(info.value) and "\n" not in str(info.value)
 
 
-def test_cli_modes_writes_the_frame_contract_and_other_commands_say_what_frames_can_do(
+def test_cli_modes_writes_the_frame_contract_and_diagnose_says_what_frames_can_do(
         tmp_path):
     out = tmp_path / "portal-modes.json"
     model = problem_file("portal-frame.toml")
@@ -161,7 +161,7 @@ def test_cli_modes_writes_the_frame_contract_and_other_commands_say_what_frames_
     assert {"member": "beam", "position": 0.2, "direction": "y"} in doc["sensors"]
     assert all(len(m["shape"]) == len(doc["sensors"]) for m in doc["modes"])
     assert doc["modes"][0]["frequency"] == pytest.approx(74.479366, rel=3e-5)
-    run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", str(model),
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "diagnose", str(model),
                           str(out)], capture_output=True, text=True)
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert len(run.stderr.strip().splitlines()) == 1 and "frame" in run.stderr
@@ -173,3 +173,93 @@ def test_cli_modes_writes_the_frame_contract_and_other_commands_say_what_frames_
 def test_a_frame_file_is_refused_where_a_beam_is_expected():
     with pytest.raises(GfeInputError, match="plane frame"):
         load_model(problem_file("portal-frame.toml"))
+
+
+def _portal_test(k, seed=3, shape_noise=0.003, freq_noise=0.0005):
+    """A portal whose beam is tied to both columns by rotational springs k, "measured" from
+    the exact solution (frequencies and shapes, tests/frame_reference.py): 6 modes, the two
+    joints and two points a member in x and y (between the mesh's nodes), with noise."""
+    model = portal_frame()
+    beam = [m.id for m in model.members].index("beam")
+    exact = exact_of(model, [("B", beam, k), ("C", beam, k)])
+    joints = tuple({"effect": "joint_spring", "member": "beam", "node": n, "stiffness": k}
+                   for n in ("B", "C"))
+    guess = frame_modes(replace(refined(model, 64), effects=joints), 6).frequencies_hz
+    f = np.array([exact.frequency_near(x, 1e-4) for x in guess])
+    sensors = [{"node": "B", "direction": "x"}, {"node": "C", "direction": "y"}]
+    for m in model.members:
+        L = model.member_length(m)
+        sensors += [{"member": m.id, "position": round(t * L, 4), "direction": d}
+                    for t in (0.33, 0.71) for d in ("x", "y")]
+    rng = np.random.default_rng(seed)
+    shapes = [exact.mode_shape(x, sensors) for x in f]
+    modes = [{"frequency": float(x * (1 + freq_noise * rng.standard_normal())),
+              "shape": [float(v) for v in y + shape_noise * np.max(np.abs(y))
+                        * rng.standard_normal(y.size)]} for x, y in zip(f, shapes)]
+    return model, joints, {"sensors": sensors, "modes": modes}, f
+
+
+def test_exact_shapes_between_nodes_are_the_models_at_its_sensors():
+    """Sensors between mesh nodes read the element shape functions rotated into the frame:
+    the converged model reproduces the exact modes there (noise-free)."""
+    from gfe_opt.correlation import mac
+    from gfe_opt.frame_data import observation
+
+    model, joints, data, f = _portal_test(2000.0, shape_noise=0.0, freq_noise=0.0)
+    fine = replace(refined(model, 64), effects=joints)
+    modes = frame_modes(fine, 6)
+    at = observation(fine, frame_mesh(fine), data["sensors"]) @ modes.shapes
+    y = np.array([m["shape"] for m in data["modes"]]).T
+    assert np.min(np.diag(mac(y, at))) > 1 - 1e-9
+    assert np.max(np.abs(modes.frequencies_hz / f - 1)) < 1e-6
+
+
+def test_compare_a_portal_whose_joints_give():
+    """The rigid-jointed model against a portal with semi-rigid beam–column joints: every
+    mode paired, the model too stiff in the sway mode; with the joints' springs in the
+    model the frequency errors fall to the noise and the mesh's error."""
+    from gfe_opt.frame_data import compare_frame, frame_measured_from_dict
+
+    model, joints, data, _ = _portal_test(2000.0)
+    measured = frame_measured_from_dict(data, model, "portal-test.json")
+    rigid = compare_frame(model, measured)
+    assert len(rigid.pairs) == 6
+    assert rigid.pairs[0].error_pct > 3.0
+    right = compare_frame(replace(model, effects=joints), measured)
+    assert len(right.pairs) == 6
+    assert max(abs(p.error_pct) for p in right.pairs) < 0.2
+    assert min(p.mac for p in right.pairs) > 0.999
+    assert right.freq_error_rms_pct < rigid.freq_error_rms_pct / 10
+    assert np.max(right.residual) < np.max(rigid.residual) / 3
+
+
+def test_cli_compare_on_a_frame(tmp_path):
+    model, _, data, _ = _portal_test(2000.0)
+    path = tmp_path / "portal-test.json"
+    path.write_text(json.dumps(data))
+    frame = str(problem_file("portal-frame.toml"))
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(path),
+                          "--json"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout)
+    assert set(out) == {"pairs", "freq_error_rms_pct", "mac_mean", "localisation", "pairing"}
+    assert len(out["pairs"]) == 6 and out["pairing"] == "mac"
+    assert len(out["localisation"]) == len(data["sensors"])
+    text = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(path)],
+                          capture_output=True, text=True)
+    assert text.returncode == 0 and "the shapes differ most at" in text.stdout
+    data["sensors"][3]["member"] = "roof"
+    path.write_text(json.dumps(data))
+    bad = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(path)],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "sensors[3].member" in bad.stderr
+    assert len(bad.stderr.strip().splitlines()) == 1
+
+
+def test_the_shipped_semirigid_portal_test_is_the_exact_solution_it_says():
+    shipped = json.loads(problem_file("portal-frame-semirigid.json").read_text())
+    _, _, data, _ = _portal_test(2000.0)
+    assert shipped["sensors"] == data["sensors"]
+    for a, b in zip(shipped["modes"], data["modes"]):
+        assert a["frequency"] == pytest.approx(b["frequency"], rel=1e-12)
+        assert np.allclose(a["shape"], b["shape"], rtol=1e-10, atol=1e-12)

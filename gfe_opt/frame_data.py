@@ -1,0 +1,275 @@
+"""Measured modes of plane frames (issue 24, contract) and their comparison with a frame model.
+
+JSON::
+
+    {"sensors": [{"node": "B", "direction": "x"},
+                 {"member": "beam", "position": 0.25, "direction": "y"}, ...],
+     "modes": [{"frequency": Hz, "shape": [one value per sensor]}, ...]}
+
+``direction`` is ``"x"``, ``"y"`` or an angle in degrees from x (counter-clockwise); a
+member sensor's ``position`` is in metres from the member's start node.  A sensor between
+mesh nodes reads the member's element shape functions (linear along the member, cubic
+Hermite across it), rotated into the frame's axes.  A frequency-only file has no
+``sensors`` and no ``shape``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import elements as el
+from .errors import GfeInputError, GfeSolverError
+from .frame import FrameMesh, FrameModel, frame_mesh, frame_modes
+
+
+@dataclass(frozen=True)
+class FrameMeasured:
+    """Measured modes of a frame: sensors (dicts of the contract), frequencies [Hz] and
+    shapes (n_sensors, n_modes; None for frequencies only)."""
+
+    sensors: list
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray | None
+    source: str = "measured"
+
+    @property
+    def n_modes(self) -> int:
+        return self.frequencies_hz.size
+
+
+def load_frame_measured(path, model: FrameModel) -> FrameMeasured:
+    """Read frame measured modes (JSON, module docstring), each sensor checked against
+    ``model``; :class:`GfeInputError` (one line) on bad input."""
+    from .inputs import read_text
+
+    where = str(path)
+    if not where.lower().endswith(".json"):
+        raise GfeInputError(where, None, "frame measured data are read from .json so far "
+                            "(README \"Plane frames\")")
+    try:
+        data = json.loads(read_text(path, "measured"))
+    except json.JSONDecodeError as exc:
+        raise GfeInputError(where, None, f"not valid JSON ({exc})") from None
+    except RecursionError:
+        raise GfeInputError(where, None, "not valid JSON (nested too deeply)") from None
+    return frame_measured_from_dict(data, model, where)
+
+
+def frame_measured_from_dict(data, model: FrameModel, where="measured") -> FrameMeasured:
+    if not isinstance(data, dict):
+        raise GfeInputError(where, None, "must be a JSON object with \"modes\"")
+    unknown = set(data) - {"sensors", "modes"}
+    if unknown:
+        raise GfeInputError(where, sorted(unknown)[0], "unknown key")
+    sensors = data.get("sensors", [])
+    if not isinstance(sensors, list):
+        raise GfeInputError(where, "sensors", "must be a list of sensors")
+    for i, s in enumerate(sensors):
+        _check_sensor(s, model, where, f"sensors[{i}]")
+    modes = data.get("modes")
+    if not isinstance(modes, list) or not modes:
+        raise GfeInputError(where, "modes", "missing or empty (a list of "
+                            "{\"frequency\": Hz, \"shape\": [...]})")
+    freqs, shapes = [], []
+    for i, m in enumerate(modes):
+        key = f"modes[{i}]"
+        if not isinstance(m, dict):
+            raise GfeInputError(where, key, "must be an object")
+        f = m.get("frequency")
+        if isinstance(f, bool) or not isinstance(f, (int, float)) or not math.isfinite(f) \
+                or f <= 0:
+            raise GfeInputError(where, key + ".frequency", f"must be > 0 Hz, got {f!r}")
+        freqs.append(float(f))
+        shape = m.get("shape")
+        if (shape is None) != (not sensors):
+            raise GfeInputError(where, key + ".shape", "one value per sensor is needed"
+                                if sensors else "a shape needs \"sensors\"")
+        if shape is not None:
+            if not isinstance(shape, list) or len(shape) != len(sensors) or not all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool)
+                    and math.isfinite(v) for v in shape):
+                raise GfeInputError(where, key + ".shape", f"must be {len(sensors)} finite "
+                                    "numbers (one per sensor)")
+            if not any(shape):
+                raise GfeInputError(where, key + ".shape", "is zero at every sensor")
+            shapes.append(shape)
+    order = np.argsort(freqs, kind="stable")
+    return FrameMeasured(sensors=list(sensors), frequencies_hz=np.array(freqs)[order],
+                         shapes=np.array(shapes, dtype=float).T[:, order] if shapes else None,
+                         source=where)
+
+
+def _check_sensor(s, model, where, key) -> None:
+    if not isinstance(s, dict):
+        raise GfeInputError(where, key, "must be an object")
+    unknown = set(s) - {"node", "member", "position", "direction"}
+    if unknown:
+        raise GfeInputError(where, f"{key}.{sorted(unknown)[0]}", "unknown key")
+    if ("node" in s) == ("member" in s):
+        raise GfeInputError(where, key, "give either \"node\" or \"member\" and \"position\"")
+    if "node" in s and s["node"] not in model.nodes:
+        raise GfeInputError(where, key + ".node", f"no node {s['node']!r} in the model")
+    if "member" in s:
+        if s["member"] not in {m.id for m in model.members}:
+            raise GfeInputError(where, key + ".member", f"no member {s['member']!r}")
+        x, length = s.get("position"), model.member_length(model.member(s["member"]))
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not 0 <= x <= length:
+            raise GfeInputError(where, key + ".position", f"must lie on the member, 0 to "
+                                f"{length:g} m, got {x!r}")
+    _angle(s.get("direction"), where, key + ".direction")
+
+
+def _angle(direction, where, key) -> float:
+    if direction == "x":
+        return 0.0
+    if direction == "y":
+        return 90.0
+    if isinstance(direction, (int, float)) and not isinstance(direction, bool) \
+            and math.isfinite(direction):
+        return float(direction)
+    raise GfeInputError(where, key, f"must be \"x\", \"y\" or an angle in degrees, got "
+                        f"{direction!r}")
+
+
+def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
+    """(n_sensors, n_dof): each sensor's reading of a displacement vector."""
+    rows, cols, vals = [], [], []
+    member_index = {m.id: k for k, m in enumerate(model.members)}
+    for i, s in enumerate(sensors):
+        a = math.radians(_angle(s["direction"], "", ""))
+        d = np.array([math.cos(a), math.sin(a)])
+        if "node" in s:
+            u, v, _ = mesh.node_dofs[s["node"]]
+            rows += [i, i]
+            cols += [u, v]
+            vals += list(d)
+            continue
+        k = member_index[s["member"]]
+        member = model.members[k]
+        L = model.member_length(member) / member.elements
+        j = min(int(s["position"] // L), member.elements - 1)
+        xi = s["position"] / L - j
+        e = int(np.flatnonzero(mesh.element_member == k)[0]) + j
+        c, sn = mesh.cosines[e]
+        R = np.array([[c, sn], [-sn, c]])            # global -> member axes
+        n_ax = el.linear(xi)                          # axial: u at the ends
+        n_tr = el.hermite(xi) * el.beam_dof_scaling(L)   # across: v, θ at the ends
+        local = np.zeros((2, 6))                     # (axial, transverse) from local DOFs
+        local[0, [0, 3]] = n_ax
+        local[1, [1, 2, 4, 5]] = n_tr
+        T = np.zeros((6, 6))
+        for o in (0, 3):
+            T[o:o + 2, o:o + 2] = R
+            T[o + 2, o + 2] = 1.0
+        row = d @ R.T @ local @ T                     # direction · (global displacement)
+        rows += [i] * 6
+        cols += mesh.element_dofs[e].tolist()
+        vals += row.tolist()
+    return sp.csr_matrix((vals, (rows, cols)), shape=(len(sensors), mesh.n_dof))
+
+
+#: shape residuals below this (relative to the largest amplitude) are rounding: far above
+#: eps times the condition of a frame's modal solve, far below any sensor's noise
+ROUNDING = 1e-9
+
+
+@dataclass(frozen=True)
+class FrameComparison:
+    """Pairs (as :class:`~gfe_opt.correlation.Pair`), the MAC matrix, each sensor's shape
+    residual over the paired modes, the notes."""
+
+    pairs: list
+    mac_matrix: np.ndarray | None
+    sensors: list
+    residual: np.ndarray | None
+    notes: list = field(default_factory=list)
+
+    @property
+    def freq_error_rms_pct(self) -> float:
+        err = np.array([p.error_pct for p in self.pairs])
+        return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
+
+    @property
+    def mac_mean(self) -> float | None:
+        if self.mac_matrix is None:
+            return None
+        return float(np.mean([p.mac for p in self.pairs])) if self.pairs else float("nan")
+
+    def failure_places(self, at_most: int = 3) -> list[tuple[dict, float]]:
+        """The sensors with the largest shape residual (relative to the largest), largest
+        first."""
+        if self.residual is None or not np.any(self.residual > ROUNDING):
+            return []
+        order = np.argsort(-self.residual, kind="stable")[:at_most]
+        return [(self.sensors[i], float(self.residual[i] / self.residual.max()))
+                for i in order]
+
+    def to_json(self) -> dict:
+        """``compare --json`` on a frame: the beam's keys, localisation by sensor."""
+        return {"pairs": [{"test_mode": p.test_mode, "model_mode": p.model_mode,
+                           "test_hz": p.test_hz, "model_hz": p.model_hz,
+                           "error_pct": p.error_pct, "mac": p.mac} for p in self.pairs],
+                "freq_error_rms_pct": self.freq_error_rms_pct, "mac_mean": self.mac_mean,
+                "localisation": None if self.residual is None else [
+                    {"sensor": s, "residual": float(r)}
+                    for s, r in zip(self.sensors, self.residual)],
+                "pairing": "frequency" if self.mac_matrix is None else "mac"}
+
+
+def compare_frame(model: FrameModel, measured: FrameMeasured,
+                  mac_threshold: float | None = None) -> FrameComparison:
+    """Pair measured and model modes (by MAC at the sensors, as for beams, or by frequency
+    without shapes), frequency errors, and each sensor's shape residual: the rms over the
+    pairs of (y − a φ)/max|y|, y the measured shape and a φ the model's at the sensors scaled
+    to it by least squares."""
+    from .correlation import DEFAULT_MAC_THRESHOLD, Pair, mac, pair_by_frequency, pair_modes
+
+    threshold = DEFAULT_MAC_THRESHOLD if mac_threshold is None else mac_threshold
+    mesh = frame_mesh(model)
+    free = mesh.n_dof - mesh.constrained.size
+    modes = frame_modes(model, min(2 * measured.n_modes + 6, free - 1))
+    f_model = modes.frequencies_hz
+    if measured.shapes is None:
+        idx = pair_by_frequency(measured.frequencies_hz, f_model)
+        mac_matrix = None
+    else:
+        at = observation(model, mesh, measured.sensors) @ modes.shapes
+        mac_matrix = mac(measured.shapes, at)
+        idx = pair_modes(np.where(f_model > 0, mac_matrix, 0.0), threshold,
+                         measured.frequencies_hz, f_model)
+    if not idx:
+        raise GfeSolverError(f"no test mode pairs with any model mode (MAC >= {threshold}); "
+                             "check sensors, directions and units")
+    pairs = [Pair(test_mode=t + 1, model_mode=m + 1, test_hz=float(measured.frequencies_hz[t]),
+                  model_hz=float(f_model[m]),
+                  error_pct=float(100 * (f_model[m] / measured.frequencies_hz[t] - 1)),
+                  mac=None if mac_matrix is None else float(mac_matrix[t, m]))
+             for t, m in idx]
+    notes = []
+    unpaired = sorted(set(range(measured.n_modes)) - {t for t, _ in idx})
+    if unpaired:
+        notes.append(f"test mode(s) {[u + 1 for u in unpaired]} have no model mode with "
+                     f"MAC >= {threshold}")
+    residual = None
+    if mac_matrix is not None:
+        r = []
+        for t, m in idx:
+            y, phi = measured.shapes[:, t], at[:, m]
+            a = float(phi @ y) / float(phi @ phi)
+            r.append((y - a * phi) / np.max(np.abs(y)))
+        residual = np.sqrt(np.mean(np.square(r), axis=0))
+    return FrameComparison(pairs=pairs, mac_matrix=mac_matrix, sensors=measured.sensors,
+                           residual=residual, notes=notes)
+
+
+def sensor_label(sensor: dict) -> str:
+    """``node B, x`` or ``beam at 0.25 m, y``."""
+    where = (f"node {sensor['node']}" if "node" in sensor
+             else f"{sensor['member']} at {sensor['position']:g} m")
+    d = sensor["direction"]
+    return f"{where}, {d if isinstance(d, str) else f'{d:g}°'}"
