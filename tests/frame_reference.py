@@ -130,6 +130,10 @@ class ExactFrame:
         _, _, vt = np.linalg.svd(self.matrix(w))
         full = np.zeros(self.n)
         full[self.free] = vt[-1]
+        # the null vector's sign: its first entry within 1e-6 of the largest magnitude
+        # positive (a symmetric frame's modes have equal peaks; rounding picks between them)
+        peak = np.flatnonzero(np.abs(full) >= (1 - 1e-6) * np.max(np.abs(full)))[0]
+        full *= np.sign(full[peak])
         out = []
         for s in sensors:
             d = s["direction"]

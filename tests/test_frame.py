@@ -257,9 +257,13 @@ def test_cli_compare_on_a_frame(tmp_path):
 
 
 def test_the_shipped_semirigid_portal_test_is_the_exact_solution_it_says():
+    """Regenerated on this machine's arithmetic: the exact roots and null vectors agree to
+    far below the noise the file carries (5e-4, 3e-3); another BLAS kernel moves the roots
+    by ~1e-12 relative."""
     shipped = json.loads(problem_file("portal-frame-semirigid.json").read_text())
     _, _, data, _ = _portal_test(2000.0)
     assert shipped["sensors"] == data["sensors"]
     for a, b in zip(shipped["modes"], data["modes"]):
-        assert a["frequency"] == pytest.approx(b["frequency"], rel=1e-12)
-        assert np.allclose(a["shape"], b["shape"], rtol=1e-10, atol=1e-12)
+        assert a["frequency"] == pytest.approx(b["frequency"], rel=1e-9)
+        assert np.max(np.abs(np.subtract(a["shape"], b["shape"]))) < 1e-8 * np.max(
+            np.abs(b["shape"]))
