@@ -335,8 +335,24 @@ class Pair:
     mac: float | None   # None: paired by frequency (a test without usable shapes)
 
 
+class PairSummary:
+    """The rms frequency error and mean MAC of a comparison's ``pairs`` (no MAC when the
+    ``pairing`` is by frequency)."""
+
+    @property
+    def freq_error_rms_pct(self) -> float:
+        err = np.array([p.error_pct for p in self.pairs])
+        return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
+
+    @property
+    def mac_mean(self) -> float | None:
+        if self.pairing == "frequency":
+            return None
+        return float(np.mean([p.mac for p in self.pairs])) if self.pairs else float("nan")
+
+
 @dataclass(frozen=True)
-class Comparison:
+class Comparison(PairSummary):
     """Result of :func:`compare` (modes numbered from 1 in ``pairs``).  A test without
     usable shapes (:attr:`~gfe_opt.measured.MeasuredModes.frequency_only`) is paired by
     frequency; its MAC matrix, COMAC, residual and expanded shapes are None."""
@@ -352,17 +368,6 @@ class Comparison:
     expanded_shapes: np.ndarray | None
     notes: list = field(default_factory=list)
     pairing: str = "mac"
-
-    @property
-    def freq_error_rms_pct(self) -> float:
-        err = np.array([p.error_pct for p in self.pairs])
-        return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
-
-    @property
-    def mac_mean(self) -> float | None:
-        if self.pairing == "frequency":
-            return None
-        return float(np.mean([p.mac for p in self.pairs])) if self.pairs else float("nan")
 
     def localisation(self) -> list[dict] | None:
         if self.residual is None:

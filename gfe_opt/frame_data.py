@@ -15,7 +15,6 @@ Hermite across it), rotated into the frame's axes.  A frequency-only file has no
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 
@@ -23,6 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import elements as el
+from .correlation import PairSummary
 from .errors import GfeInputError, GfeSolverError
 from .frame import FrameMesh, FrameModel, frame_mesh, frame_modes
 
@@ -45,19 +45,13 @@ class FrameMeasured:
 def load_frame_measured(path, model: FrameModel) -> FrameMeasured:
     """Read frame measured modes (JSON, module docstring), each sensor checked against
     ``model``; :class:`GfeInputError` (one line) on bad input."""
-    from .inputs import read_text
+    from .measured import read_json
 
     where = str(path)
     if not where.lower().endswith(".json"):
         raise GfeInputError(where, None, "frame measured data are read from .json so far "
                             "(README \"Plane frames\")")
-    try:
-        data = json.loads(read_text(path, "measured"))
-    except json.JSONDecodeError as exc:
-        raise GfeInputError(where, None, f"not valid JSON ({exc})") from None
-    except RecursionError:
-        raise GfeInputError(where, None, "not valid JSON (nested too deeply)") from None
-    return frame_measured_from_dict(data, model, where)
+    return frame_measured_from_dict(read_json(path), model, where)
 
 
 def frame_measured_from_dict(data, model: FrameModel, where="measured") -> FrameMeasured:
@@ -179,7 +173,7 @@ ROUNDING = 1e-9
 
 
 @dataclass(frozen=True)
-class FrameComparison:
+class FrameComparison(PairSummary):
     """Pairs (as :class:`~gfe_opt.correlation.Pair`), the MAC matrix, each sensor's shape
     residual over the paired modes, the notes."""
 
@@ -190,15 +184,8 @@ class FrameComparison:
     notes: list = field(default_factory=list)
 
     @property
-    def freq_error_rms_pct(self) -> float:
-        err = np.array([p.error_pct for p in self.pairs])
-        return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
-
-    @property
-    def mac_mean(self) -> float | None:
-        if self.mac_matrix is None:
-            return None
-        return float(np.mean([p.mac for p in self.pairs])) if self.pairs else float("nan")
+    def pairing(self) -> str:
+        return "frequency" if self.mac_matrix is None else "mac"
 
     def failure_places(self, at_most: int = 3) -> list[tuple[dict, float]]:
         """The sensors with the largest shape residual (relative to the largest), largest
@@ -218,7 +205,7 @@ class FrameComparison:
                 "localisation": None if self.residual is None else [
                     {"sensor": s, "residual": float(r)}
                     for s, r in zip(self.sensors, self.residual)],
-                "pairing": "frequency" if self.mac_matrix is None else "mac"}
+                "pairing": self.pairing}
 
 
 def compare_frame(model: FrameModel, measured: FrameMeasured,

@@ -230,14 +230,20 @@ def load_measured(path, dof: str | None = None) -> MeasuredModes:
                         "(use .json, .csv, .uff or .unv)")
 
 
-def _read_json(path: Path) -> MeasuredModes:
+def read_json(path, what: str = "measured"):
+    """The parsed JSON of an input file; a file that is not JSON is one line."""
     where = str(path)
     try:
-        data = json.loads(read_text(path, "measured"))
+        return json.loads(read_text(path, what))
     except json.JSONDecodeError as exc:
         raise GfeInputError(where, None, f"not valid JSON ({exc})") from None
     except RecursionError:
         raise GfeInputError(where, None, "not valid JSON (nested too deeply)") from None
+
+
+def _read_json(path: Path) -> MeasuredModes:
+    where = str(path)
+    data = read_json(path)
     if not isinstance(data, dict):
         raise GfeInputError(where, None, "top level must be an object with sensors and modes")
     for key in data:

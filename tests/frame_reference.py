@@ -89,12 +89,7 @@ class ExactFrame:
             R = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
             T = np.zeros((6, 6))
             T[:3, :3], T[3:, 3:] = R, R
-            dofs = [3 * self.ids.index(a) + i for i in range(3)] + \
-                   [3 * self.ids.index(b) + i for i in range(3)]
-            if (k, a) in self.end_theta:
-                dofs[2] = self.end_theta[(k, a)]
-            if (k, b) in self.end_theta:
-                dofs[5] = self.end_theta[(k, b)]
+            dofs = self._member_dofs(k)
             Dm = member_dynamic_stiffness(E, rho, A, inertia, L, omega)
             D[np.ix_(dofs, dofs)] += T.T @ Dm @ T
         for i, j, k in self.springs:
@@ -114,6 +109,17 @@ class ExactFrame:
         if g(lo) * g(hi) > 0:
             raise ValueError(f"no root within {width:g} of {estimate_hz:g} Hz")
         return brentq(g, lo, hi, xtol=1e-14 * w0, rtol=1e-15) / (2 * math.pi)
+
+    def _member_dofs(self, k) -> list[int]:
+        """u, v, θ at the member's start, then at its end (a joint spring's own θ)."""
+        a, b = self.members[k][:2]
+        dofs = [3 * self.ids.index(a) + i for i in range(3)] + \
+               [3 * self.ids.index(b) + i for i in range(3)]
+        if (k, a) in self.end_theta:
+            dofs[2] = self.end_theta[(k, a)]
+        if (k, b) in self.end_theta:
+            dofs[5] = self.end_theta[(k, b)]
+        return dofs
 
     def _member_axes(self, k):
         a, b = self.members[k][:2]
@@ -147,12 +153,7 @@ class ExactFrame:
             a, b, E, rho, A, inertia = self.members[k]
             L, c, sn = self._member_axes(k)
             R = np.array([[c, sn], [-sn, c]])
-            dofs = [3 * self.ids.index(a) + i for i in range(3)] + \
-                   [3 * self.ids.index(b) + i for i in range(3)]
-            if (k, a) in self.end_theta:
-                dofs[2] = self.end_theta[(k, a)]
-            if (k, b) in self.end_theta:
-                dofs[5] = self.end_theta[(k, b)]
+            dofs = self._member_dofs(k)
             g = full[dofs]
             u1, v1 = R @ g[0:2]
             u2, v2 = R @ g[3:5]
