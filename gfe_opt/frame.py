@@ -20,6 +20,8 @@ Model file (``kind = "frame"``; README "Plane frames")::
     [[supports]] node, type = "clamped" | "pinned" | "roller-x" | "roller-y"
     [[effects]]  effect = "crack": member, position (m from its start node), depth_ratio
                  effect = "joint_spring": node, member, stiffness (N m/rad)
+                 effect = "support_spring": node, stiffness (N m/rad; a support's rotation)
+                 effect = "support_translation": node, direction = "x" | "y", stiffness (N/m)
 
 So far frames have modes (:func:`frame_modes`, ``gfe-opt modes``); comparing, diagnosing
 and updating them are the next parts of the issue.
@@ -37,7 +39,9 @@ from . import elements as el
 from .errors import GfeInputError
 
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
-FRAME_EFFECTS = ("crack", "joint_spring")
+FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation")
+#: the fixity each support effect replaces by a spring: rotation; translation along x / y
+RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 #: a crack's Christides–Barr disturbance is below 1e-15 beyond this many decay lengths
 CRACK_REACH = 18.0
 
@@ -179,6 +183,13 @@ def frame_from_dict(data: dict, where: str = "model") -> FrameModel:
                        supports=tuple(supports), source=where)
     effects = tuple(_effect(model, raw, where, f"effects[{i}].")
                     for i, raw in enumerate(_array(data, "effects", where, required=False)))
+    seen = {}
+    for i, e in enumerate(effects):
+        key = _effect_key(e)
+        if key is not None and key in seen:
+            raise GfeInputError(where, f"effects[{i}]", f"repeats effects[{seen[key]}] (one "
+                                f"{e['effect']} at one place)")
+        seen.setdefault(key, i)
     return FrameModel(name=name, nodes=nodes, members=tuple(members),
                       supports=tuple(supports), effects=effects, source=where)
 
@@ -270,6 +281,8 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
     if name not in FRAME_EFFECTS:
         raise GfeInputError(where, prefix + "effect", f"{name!r} is not an effect frames take "
                             f"yet (known: {', '.join(FRAME_EFFECTS)})")
+    if name in ("support_spring", "support_translation"):
+        return _support_effect(model, raw, where, prefix)
     member_id = _ident(raw, "member", where, prefix)
     if member_id not in {m.id for m in model.members}:
         raise GfeInputError(where, prefix + "member", f"no member {member_id!r}")
@@ -298,6 +311,47 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
     return {"effect": name, "member": member_id, "node": node, "stiffness": k}
 
 
+def _support_effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
+    """A support that gives: its rotation (``support_spring``, N m/rad) or its translation
+    along ``direction`` x or y (``support_translation``, N/m) held by a spring instead of
+    fixed; the node's support must fix that DOF."""
+    from .effects.base import no_unknown
+    from .model import _number
+
+    name = raw["effect"]
+    keys = {"effect", "node", "stiffness"} | ({"direction"} if name == "support_translation"
+                                              else set())
+    no_unknown(raw, keys, where, prefix)
+    node = _ident(raw, "node", where, prefix)
+    held = dict(model.supports).get(node)
+    if held is None:
+        raise GfeInputError(where, prefix + "node", f"node {node!r} has no support to give "
+                            f"(supported: {', '.join(n for n, _ in model.supports) or 'none'})")
+    out = {"effect": name, "node": node}
+    if name == "support_translation":
+        d = raw.get("direction")
+        if d not in ("x", "y"):
+            raise GfeInputError(where, prefix + "direction", f"must be \"x\" or \"y\", got "
+                                f"{d!r}")
+        out["direction"] = d
+    dof = RELEASES[out.get("direction", name)]
+    if dof not in SUPPORT_TYPES[held]:
+        what = "rotation" if dof == 2 else f"translation along {out['direction']}"
+        raise GfeInputError(where, prefix + "node", f"the {held} support at {node!r} does "
+                            f"not fix its {what}")
+    out["stiffness"] = _number(raw, "stiffness", where, positive=True, prefix=prefix)
+    return out
+
+
+def _effect_key(e: dict) -> tuple | None:
+    """What two instances of a frame effect may not share (a crack may repeat)."""
+    if e["effect"] == "joint_spring":
+        return ("joint_spring", e["member"], e["node"])
+    if e["effect"] == "crack":
+        return None
+    return (e["effect"], e["node"], e.get("direction"))
+
+
 # ------------------------------------------------------------------------------------------
 # mesh and matrices
 # ------------------------------------------------------------------------------------------
@@ -316,6 +370,7 @@ class FrameMesh:
     node_dofs: dict                 # node id -> (u, v, θ)
     member_nodes: tuple             # per member: mesh node indices along it
     springs: tuple                  # (θ dof, θ dof, k)
+    grounded: tuple                 # (dof, k): a support that gives
     n_dof: int
     constrained: np.ndarray
 
@@ -359,14 +414,21 @@ def frame_mesh(model: FrameModel) -> FrameMesh:
             el_dofs.append(np.concatenate([a, b]))
             el_len.append(length / m.elements)
             cos.append((c, s))
-    fixed = [int(dofs[ids.index(node), d]) for node, kind in model.supports
-             for d in SUPPORT_TYPES[kind]]
+    fixed = {int(dofs[ids.index(node), d]) for node, kind in model.supports
+             for d in SUPPORT_TYPES[kind]}
+    grounded = []
+    for e in model.effects:
+        if e["effect"] in ("support_spring", "support_translation"):
+            dof = int(dofs[ids.index(e["node"]), RELEASES[e.get("direction", e["effect"])]])
+            fixed.discard(dof)
+            grounded.append((dof, float(e["stiffness"])))
     return FrameMesh(xy=np.array(xy, dtype=float), element_member=np.array(el_member),
                      element_dofs=np.array(el_dofs), element_length=np.array(el_len),
                      cosines=np.array(cos), node_dofs={i: tuple(int(d) for d in dofs[n])
                                                        for n, i in enumerate(ids)},
-                     member_nodes=tuple(member_nodes), springs=tuple(springs), n_dof=n_dof,
-                     constrained=np.array(sorted(set(fixed)), dtype=int))
+                     member_nodes=tuple(member_nodes), springs=tuple(springs),
+                     grounded=tuple(grounded), n_dof=n_dof,
+                     constrained=np.array(sorted(fixed), dtype=int))
 
 
 def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
@@ -449,6 +511,9 @@ def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
     M = sp.coo_matrix((Me.ravel(), (rows, cols)), shape=shape).tocsr()
     for a, b, k in mesh.springs:
         K = K + sp.csr_matrix(([k, -k, -k, k], ([a, a, b, b], [a, b, a, b])), shape=shape)
+    if mesh.grounded:
+        dof, k = zip(*mesh.grounded)
+        K = K + sp.csr_matrix((k, (dof, dof)), shape=shape)
     return K, M
 
 
@@ -497,6 +562,8 @@ def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:
     total = energy.sum(axis=0)
     for a, b, k in mesh.springs:
         total = total + k * (shapes[a] - shapes[b]) ** 2
+    for dof, k in mesh.grounded:
+        total = total + k * shapes[dof] ** 2
     return total
 
 

@@ -54,10 +54,13 @@ def member_dynamic_stiffness(E, rho, A, inertia, L, omega) -> np.ndarray:
 class ExactFrame:
     """A frame of uniform members: ``nodes`` {id: (x, y)}, ``members`` [(from, to, E, rho,
     A, I)], ``supports`` {id: type}, ``joint_springs`` [(node, member index, k)],
-    ``member_ids`` the members' names (for sensors on them)."""
+    ``member_ids`` the members' names (for sensors on them), ``ground_springs`` [(node, DOF
+    0/1/2 for u/v/θ, k)]: a support's fixity of that DOF replaced by a spring to ground."""
 
-    def __init__(self, nodes, members, supports, joint_springs=(), member_ids=None):
+    def __init__(self, nodes, members, supports, joint_springs=(), member_ids=None,
+                 ground_springs=()):
         self.ids = list(nodes)
+        self.ground = [(3 * self.ids.index(node) + dof, k) for node, dof, k in ground_springs]
         self.member_ids = list(member_ids or range(len(members)))
         self.nodes = nodes
         self.members = members
@@ -70,6 +73,7 @@ class ExactFrame:
             n += 1
         self.n = n
         fixed = {3 * self.ids.index(i) + d for i, t in supports.items() for d in SUPPORTS[t]}
+        fixed -= {dof for dof, _ in self.ground}
         self.free = np.array([d for d in range(n) if d not in fixed])
         E, _, _, inertia = members[0][2:]
         L = max(self._length(m) for m in members)
@@ -94,6 +98,8 @@ class ExactFrame:
             D[np.ix_(dofs, dofs)] += T.T @ Dm @ T
         for i, j, k in self.springs:
             D[np.ix_([i, j], [i, j])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
+        for i, k in self.ground:
+            D[i, i] += k
         return D[np.ix_(self.free, self.free)] / self.scale
 
     def frequency_near(self, estimate_hz, width=1e-3) -> float:

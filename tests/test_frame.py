@@ -20,10 +20,10 @@ from gfe_opt.problems import portal_frame, problem_file, three_storey_frame
 from .frame_reference import ExactFrame, member_dynamic_stiffness
 
 
-def exact_of(model, joint_springs=()):
+def exact_of(model, joint_springs=(), ground_springs=()):
     return ExactFrame(model.nodes, [(m.start, m.end, m.E, m.rho, m.area, m.inertia)
                                     for m in model.members], dict(model.supports),
-                      joint_springs, [m.id for m in model.members])
+                      joint_springs, [m.id for m in model.members], ground_springs)
 
 
 def refined(model, n):
@@ -127,6 +127,32 @@ def test_a_one_member_frame_is_the_beam_with_its_crack():
         assert np.min(np.abs(frame / f - 1)) < 2e-8
 
 
+def test_supports_that_give_against_the_exact_solution_and_their_limits():
+    """Both bases' rotation held by springs of the column's 4EI/h, and one base's x
+    translation by a spring: within 1e-6 of the exact solution; stiff springs are the
+    clamps, soft rotational ones the pinned portal."""
+    base = portal_frame(64)
+    col = base.member("left-column")
+    k = 4 * col.E * col.inertia / base.member_length(col)
+    effects = ({"effect": "support_spring", "node": "A", "stiffness": k},
+               {"effect": "support_spring", "node": "D", "stiffness": k},
+               {"effect": "support_translation", "node": "A", "direction": "x",
+                "stiffness": 1e6})
+    f = frame_modes(replace(base, effects=effects), 6).frequencies_hz
+    exact = exact_of(base, ground_springs=[("A", 2, k), ("D", 2, k), ("A", 0, 1e6)])
+    assert np.max(np.abs(f / [exact.frequency_near(x, 1e-4) for x in f] - 1)) < 1e-6
+    clamped = frame_modes(base, 6).frequencies_hz
+    assert f[0] < 0.9 * clamped[0]
+
+    def rotational(stiffness):
+        return replace(base, effects=tuple(dict(e, stiffness=stiffness) for e in effects[:2]))
+
+    assert np.allclose(frame_modes(rotational(1e10), 6).frequencies_hz, clamped, rtol=1e-6)
+    pinned = replace(base, supports=(("A", "pinned"), ("D", "pinned")))
+    assert np.allclose(frame_modes(rotational(1e-6), 6).frequencies_hz,
+                       frame_modes(pinned, 6).frequencies_hz, rtol=1e-6)
+
+
 @pytest.mark.parametrize("change, key", [
     (lambda d: d["members"][0].update({"to": "Z"}), "members[0].to"),
     (lambda d: d["supports"][0].update({"type": "fixed"}), "supports[0].type"),
@@ -135,6 +161,13 @@ def test_a_one_member_frame_is_the_beam_with_its_crack():
                                       "node": "A", "stiffness": 10.0}]}), "effects[0].node"),
     (lambda d: d.update({"effects": [{"effect": "point_mass", "member": "beam"}]}),
      "effects[0].effect"),
+    (lambda d: d.update({"effects": [{"effect": "support_spring", "node": "B",
+                                      "stiffness": 1.0}]}), "effects[0].node"),
+    (lambda d: (d["supports"][0].update({"type": "roller-x"}), d.update({"effects": [
+        {"effect": "support_translation", "node": "A", "direction": "x",
+         "stiffness": 1.0}]})), "effects[0].node"),
+    (lambda d: d.update({"effects": [{"effect": "joint_spring", "member": "beam",
+                                      "node": "B", "stiffness": 10.0}] * 2}), "effects[1]"),
 ])
 def test_bad_frame_files_are_one_line_naming_the_key(change, key):
     import tomllib
