@@ -594,9 +594,10 @@ def write_frame_modes(model: FrameModel, n_modes: int, path, *, force: bool = Fa
     from .outputs import atomic_write, check_output_path
 
     path = check_output_path(path, force, protect, kind="modes")
-    if path.suffix.lower() != ".json":
-        raise GfeInputError(str(path), None, "a frame's modes are written as .json (the frame "
-                            "measured-data format; CSV and UFF for frames are not there yet)")
+    suffix = path.suffix.lower()
+    if suffix not in (".json", ".uff", ".unv"):
+        raise GfeInputError(str(path), None, "a frame's modes are written as .json or "
+                            ".uff/.unv (CSV for frames is not there yet)")
     mesh = frame_mesh(model)
     free = mesh.n_dof - mesh.constrained.size
     modes = frame_modes(model, min(n_modes + 3, free - 1))
@@ -606,7 +607,35 @@ def write_frame_modes(model: FrameModel, n_modes: int, path, *, force: bool = Fa
            "modes": [{"frequency": float(modes.frequencies_hz[j]),
                       "shape": [float(modes.shapes[dof, j]) for _, dof in sensors]}
                      for j in elastic]}
-    text = json.dumps(doc, indent=1)
-    atomic_write(path, lambda p: p.write_text(text + "\n", encoding="utf-8"), replace=force)
+    if suffix == ".json":
+        text = json.dumps(doc, indent=1)
+        atomic_write(path, lambda p: p.write_text(text + "\n", encoding="utf-8"),
+                     replace=force)
+    else:
+        atomic_write(path, lambda p: _write_uff(mesh, modes, elastic, p), replace=force)
     rigid = int(np.sum(modes.frequencies_hz[:elastic[0]] == 0)) if elastic.size else 0
     return elastic.size, len(sensors), rigid
+
+
+def _write_uff(mesh: FrameMesh, modes, columns, path) -> None:
+    """Dataset 2411 (every mesh node's x, y) and one dataset 55 per mode (u, v in r1, r2;
+    zero at a support's fixed translation)."""
+    import pyuff
+
+    n = mesh.xy.shape[0]
+    nodes = np.arange(1, n + 1)
+    zeros = np.zeros(n)
+    sets = [pyuff.prepare_2411(node_nums=nodes, def_cs=np.zeros(n, int),
+                               disp_cs=np.zeros(n, int), color=np.ones(n, int),
+                               x=mesh.xy[:, 0], y=mesh.xy[:, 1], z=zeros,
+                               return_full_dict=True)]
+    for j in columns:
+        shape = modes.shapes[:3 * n, j]
+        sets.append(pyuff.prepare_55(
+            id1=f"gfe-opt mode {j + 1}", id2="NONE", id3="NONE", id4="NONE", id5="NONE",
+            model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, data_type=2,
+            n_data_per_node=3, load_case=1, mode_n=int(j) + 1,
+            freq=float(modes.frequencies_hz[j]), modal_m=0.0, modal_damp_vis=0.0,
+            modal_damp_his=0.0, node_nums=nodes, r1=shape[0::3].astype(float),
+            r2=shape[1::3].astype(float), r3=zeros))
+    pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")

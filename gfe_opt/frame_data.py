@@ -48,10 +48,75 @@ def load_frame_measured(path, model: FrameModel) -> FrameMeasured:
     from .measured import read_json
 
     where = str(path)
-    if not where.lower().endswith(".json"):
-        raise GfeInputError(where, None, "frame measured data are read from .json so far "
-                            "(README \"Plane frames\")")
+    suffix = where.lower().rsplit(".", 1)[-1]
+    if suffix in ("uff", "unv"):
+        return _read_frame_uff(path, model)
+    if suffix != "json":
+        raise GfeInputError(where, None, "frame measured data are read from .json, .uff or "
+                            ".unv (README \"Plane frames\")")
     return frame_measured_from_dict(read_json(path), model, where)
+
+
+def locate(model: FrameModel, x: float, y: float) -> dict | None:
+    """Where a point (m) lies on the frame: ``{"node": id}`` at a named node, else
+    ``{"member": id, "position": m}`` on a member (within 1e-6 of the frame's size), else
+    None."""
+    points = np.array(list(model.nodes.values()))
+    tol = 1e-6 * max(float(np.ptp(points[:, 0])), float(np.ptp(points[:, 1])))
+    for node, (nx, ny) in model.nodes.items():
+        if math.hypot(x - nx, y - ny) <= tol:
+            return {"node": node}
+    for m in model.members:
+        (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
+        length = model.member_length(m)
+        c, s = (x1 - x0) / length, (y1 - y0) / length
+        along = (x - x0) * c + (y - y0) * s
+        across = -(x - x0) * s + (y - y0) * c
+        if abs(across) <= tol and -tol <= along <= length + tol:
+            return {"member": m.id, "position": float(min(max(along, 0.0), length))}
+    return None
+
+
+def _read_frame_uff(path, model: FrameModel) -> FrameMeasured:
+    """A universal file of a frame test: node coordinates (x, y) from dataset 15 or 2411,
+    one dataset 55 (normal mode) per mode with the x and y components in r1 and r2.  Each
+    node is placed on the frame (:func:`locate`); each of its two components that is not
+    zero in every mode is a sensor in that direction."""
+    from .measured import read_uff_sets
+
+    where = str(path)
+    sets, coords = read_uff_sets(path, plane=True)
+    modes = [s for s in sets if s.get("type") == 55 and s.get("analysis_type") == 2]
+    if not coords:
+        raise GfeInputError(where, "dataset 15/2411", "no node coordinates found")
+    if not modes:
+        raise GfeInputError(where, "dataset 55", "no normal-mode data (analysis type 2) found")
+    nodes = [int(n) for n in np.asarray(modes[0]["node_nums"]).astype(int)]
+    for i, m in enumerate(modes):
+        if [int(n) for n in np.asarray(m["node_nums"]).astype(int)] != nodes:
+            raise GfeInputError(where, f"dataset 55 #{i + 1}", "nodes differ from the first "
+                                "mode")
+    values = {c: np.array([np.real(np.asarray(m[c], dtype=complex)).ravel() for m in modes])
+              for c in ("r1", "r2")}
+    if any(v.shape != (len(modes), len(nodes)) for v in values.values()):
+        raise GfeInputError(where, "dataset 55", "a mode has fewer values than nodes (a "
+                            "damaged record)")
+    sensors, columns = [], []
+    for j, n in enumerate(nodes):
+        if n not in coords:
+            raise GfeInputError(where, "dataset 55", f"node {n} has no coordinates")
+        place = locate(model, *coords[n])
+        if place is None:
+            raise GfeInputError(where, f"node {n}", f"at ({coords[n][0]:g}, {coords[n][1]:g}) "
+                                f"m it lies on no member of {model.name}")
+        for comp, direction in (("r1", "x"), ("r2", "y")):
+            if np.any(values[comp][:, j] != 0):
+                sensors.append({**place, "direction": direction})
+                columns.append(values[comp][:, j])
+    data = {"sensors": sensors, "modes": [
+        {"frequency": float(m["freq"]), "shape": [float(c[i]) for c in columns]}
+        for i, m in enumerate(modes)]}
+    return frame_measured_from_dict(data, model, where)
 
 
 def frame_measured_from_dict(data, model: FrameModel, where="measured") -> FrameMeasured:

@@ -400,9 +400,9 @@ def _check_uff_complete(path: Path) -> None:
                             "was it cut short?")
 
 
-def read_uff_sets(path: Path) -> tuple[list, dict]:
+def read_uff_sets(path: Path, plane: bool = False) -> tuple[list, dict]:
     """The datasets of a universal file (pyuff) and its node x coordinates (datasets 15 and
-    2411); a file cut short or unreadable is one line."""
+    2411; with ``plane`` (x, y)); a file cut short or unreadable is one line."""
     import pyuff
 
     _check_uff_complete(path)
@@ -414,8 +414,8 @@ def read_uff_sets(path: Path) -> tuple[list, dict]:
     coords = {}
     for s in sets:
         if s.get("type") in (15, 2411):
-            for n, x in zip(np.asarray(s["node_nums"]).astype(int), s["x"]):
-                coords[int(n)] = float(x)
+            for n, x, y in zip(np.asarray(s["node_nums"]).astype(int), s["x"], s["y"]):
+                coords[int(n)] = (float(x), float(y)) if plane else float(x)
     return sets, coords
 
 

@@ -300,3 +300,84 @@ def test_the_shipped_semirigid_portal_test_is_the_exact_solution_it_says():
         assert a["frequency"] == pytest.approx(b["frequency"], rel=1e-9)
         assert np.max(np.abs(np.subtract(a["shape"], b["shape"]))) < 1e-8 * np.max(
             np.abs(b["shape"]))
+
+
+def _uff_of(tmp_path, points, modes, name="frame-test.uff"):
+    """A universal file of a frame test as a test system writes it: dataset 2411 with each
+    point's (x, y), one dataset 55 per mode with the x and y components (r1, r2)."""
+    import pyuff
+
+    n = len(points)
+    nodes = np.arange(101, 101 + n)
+    zeros = np.zeros(n)
+    xy = np.array(points, dtype=float)
+    sets = [pyuff.prepare_2411(node_nums=nodes, def_cs=np.zeros(n, int),
+                               disp_cs=np.zeros(n, int), color=np.ones(n, int),
+                               x=xy[:, 0], y=xy[:, 1], z=zeros, return_full_dict=True)]
+    for j, (f, ux, uy) in enumerate(modes):
+        sets.append(pyuff.prepare_55(
+            id1=f"mode {j + 1}", id2="NONE", id3="NONE", id4="NONE", id5="NONE",
+            model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, data_type=2,
+            n_data_per_node=3, load_case=1, mode_n=j + 1, freq=f, modal_m=0.0,
+            modal_damp_vis=0.0, modal_damp_his=0.0, node_nums=nodes,
+            r1=np.asarray(ux, float), r2=np.asarray(uy, float), r3=zeros))
+    path = tmp_path / name
+    pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")
+    return path
+
+
+def test_a_uff_test_of_a_frame_reads_in_without_editing(tmp_path):
+    """The semi-rigid portal measured at both joints (x and y) and at points along the
+    members (across each member only, the other component left zero, as a test with
+    one-axis accelerometers writes it): each point placed on its member, each measured
+    component a sensor, and the comparison the same as from the JSON contract."""
+    from gfe_opt.frame_data import compare_frame, frame_measured_from_dict, load_frame_measured
+
+    model, joints, _, f = _portal_test(2000.0, shape_noise=0.0, freq_noise=0.0)
+    exact = exact_of(model, [("B", 1, 2000.0), ("C", 1, 2000.0)])
+    points = [(0.0, 0.3), (0.4, 0.3), (0.0, 0.1), (0.0, 0.2), (0.1, 0.3), (0.3, 0.3),
+              (0.4, 0.15)]
+    sensors = [{"node": "B", "direction": "x"}, {"node": "B", "direction": "y"},
+               {"node": "C", "direction": "x"}, {"node": "C", "direction": "y"},
+               {"member": "left-column", "position": 0.1, "direction": "x"},
+               {"member": "left-column", "position": 0.2, "direction": "x"},
+               {"member": "beam", "position": 0.1, "direction": "y"},
+               {"member": "beam", "position": 0.3, "direction": "y"},
+               {"member": "right-column", "position": 0.15, "direction": "x"}]
+    shapes = [exact.mode_shape(x, sensors) for x in f]
+    modes = []
+    for x, y in zip(f, shapes):
+        ux = [y[0], y[2], y[4], y[5], 0.0, 0.0, y[8]]
+        uy = [y[1], y[3], 0.0, 0.0, y[6], y[7], 0.0]
+        modes.append((float(x), ux, uy))
+    measured = load_frame_measured(_uff_of(tmp_path, points, modes), model)
+    as_set = [{k: round(v, 9) if isinstance(v, float) else v for k, v in s.items()}
+              for s in measured.sensors]
+    assert sorted(map(str, as_set)) == sorted(map(str, sensors))
+    from_uff = compare_frame(replace(model, effects=joints), measured)
+    direct = compare_frame(replace(model, effects=joints), frame_measured_from_dict(
+        {"sensors": sensors, "modes": [{"frequency": float(x), "shape": list(y)}
+                                       for x, y in zip(f, shapes)]}, model))
+    assert [(p.test_mode, p.model_mode) for p in from_uff.pairs] == \
+        [(p.test_mode, p.model_mode) for p in direct.pairs]
+    for a, b in zip(from_uff.pairs, direct.pairs):
+        assert a.model_hz == b.model_hz and abs(a.test_hz / b.test_hz - 1) < 1e-5
+        assert a.mac > 0.9999 and b.mac > 0.9999
+    off = _uff_of(tmp_path, [(0.2, 0.15)], [(50.0, [1.0], [0.0])], "off.uff")
+    with pytest.raises(GfeInputError, match="lies on no member"):
+        load_frame_measured(off, model)
+
+
+def test_gfe_opt_modes_writes_a_frame_uff_that_compares_with_its_model(tmp_path):
+    out = tmp_path / "portal.uff"
+    model = str(problem_file("portal-frame.toml"))
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "modes", model, "--out", str(out),
+                          "--modes", "5"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", model, str(out),
+                          "--json"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    pairs = json.loads(run.stdout)["pairs"]
+    assert [(p["test_mode"], p["model_mode"]) for p in pairs] == [(i, i) for i in range(1, 6)]
+    # dataset 55 holds a frequency to 6 significant digits (pyuff's field): 1e-5 at most
+    assert all(abs(p["error_pct"]) < 1e-3 and p["mac"] > 0.99999 for p in pairs)
