@@ -247,6 +247,8 @@ class FrameComparison(PairSummary):
     sensors: list
     residual: np.ndarray | None
     notes: list = field(default_factory=list)
+    model_modes: object = None        # Modes of the model (all DOFs), for the figures
+    scale: np.ndarray | None = None   # per pair: the factor that fits the model's shape to y
 
     @property
     def pairing(self) -> str:
@@ -309,14 +311,62 @@ def compare_frame(model: FrameModel, measured: FrameMeasured,
                      f"MAC >= {threshold}")
     residual = None
     if mac_matrix is not None:
-        r = []
+        r, scale = [], []
         for t, m in idx:
             y, phi = measured.shapes[:, t], at[:, m]
             a = float(phi @ y) / float(phi @ phi)
+            scale.append(a)
             r.append((y - a * phi) / np.max(np.abs(y)))
         residual = np.sqrt(np.mean(np.square(r), axis=0))
     return FrameComparison(pairs=pairs, mac_matrix=mac_matrix, sensors=measured.sensors,
-                           residual=residual, notes=notes)
+                           residual=residual, notes=notes, model_modes=modes,
+                           scale=None if residual is None else np.array(scale))
+
+
+def sensor_places(model: FrameModel, sensors) -> tuple[np.ndarray, np.ndarray]:
+    """Each sensor's point (x, y) and unit direction, in the frame's axes."""
+    points, directions = [], []
+    for s in sensors:
+        if "node" in s:
+            points.append(model.nodes[s["node"]])
+        else:
+            m = model.member(s["member"])
+            (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
+            t = s["position"] / model.member_length(m)
+            points.append((x0 + t * (x1 - x0), y0 + t * (y1 - y0)))
+        a = math.radians(_angle(s["direction"], "", ""))
+        directions.append((math.cos(a), math.sin(a)))
+    return np.array(points, dtype=float), np.array(directions)
+
+
+def frame_figures(result: FrameComparison, model: FrameModel, measured: FrameMeasured) -> dict:
+    """``compare --plot`` on a frame: the MAC matrix, paired frequencies, each paired mode
+    drawn on the frame (the model's deformed shape, the measured displacements as arrows)
+    and the frame with every sensor coloured by its shape residual."""
+    from . import plots
+
+    pairs = [(p.test_mode - 1, p.model_mode - 1) for p in result.pairs]
+    figs = {"frequencies.png": plots.paired_frequencies(result.pairs)}
+    if result.mac_matrix is None:
+        return figs
+    mesh = frame_mesh(model)
+    points, directions = sensor_places(model, measured.sensors)
+    members = [mesh.xy[nodes] for nodes in mesh.member_nodes]
+    shapes = []
+    for (t, m), a in zip(pairs, result.scale):
+        phi = result.model_modes.shapes[:, m] * a
+        n = mesh.xy.shape[0]
+        shapes.append((phi[0:3 * n:3], phi[1:3 * n:3], measured.shapes[:, t]))
+    titles = [f"mode {p.test_mode}: {p.test_hz:.4g} Hz test, {p.model_hz:.4g} Hz model, "
+              f"MAC {p.mac:.3f}" for p in result.pairs]
+    figs["mac.png"] = plots.mac_matrix(result.mac_matrix, pairs)
+    figs["frame_modes.png"] = plots.frame_modes(members, mesh.member_nodes, mesh.xy, shapes,
+                                                points, directions, titles)
+    figs["frame_localisation.png"] = plots.frame_localisation(
+        members, points, result.residual,
+        [sensor_label(s) for s, _ in result.failure_places()],
+        [sensor_label(s) for s in measured.sensors])
+    return figs
 
 
 def sensor_label(sensor: dict) -> str:

@@ -18,5 +18,8 @@ DEFAULT_FIT_SHAPE_NOISE = 0.003
 FRF_FORMS = ("accelerance", "mobility", "receptance")
 #: figures written by ``compare`` and ``diagnose`` with ``--plot``
 COMPARE_FIGURES = ("mac.png", "frequencies.png", "localisation.png")
+#: figures written by ``compare`` on a plane frame with ``--plot``
+FRAME_COMPARE_FIGURES = ("mac.png", "frequencies.png", "frame_modes.png",
+                         "frame_localisation.png")
 DIAGNOSIS_FIGURES = ("candidates.png", "stiffness_change.png", "disturbance.png",
                      "nodal_equations.png")

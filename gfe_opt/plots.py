@@ -429,3 +429,64 @@ def _trend_axis(ax, trend):
         ax.set_xlabel("set")
         if len(trend.ticks) <= 20:
             ax.set_xticks(trend.x, trend.ticks, rotation=30, ha="right", fontsize=7)
+
+
+def _frame_axes(ax, members, color="0.75", lw=1.0):
+    for xy in members:
+        ax.plot(xy[:, 0], xy[:, 1], color=color, lw=lw)
+    ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+
+
+def frame_modes(members, member_nodes, xy, shapes, points, directions, titles):
+    """Paired modes drawn on a frame: the undeformed members (grey), the model's mode
+    (blue, mesh nodes moved by its u, v scaled to the test) and the measured displacement
+    at each sensor (red arrows along the sensor's direction), one panel a pair."""
+    n = len(shapes)
+    cols = min(n, 3)
+    rows = -(-n // cols)
+    fig = _figure(4.0 * cols, 3.6 * rows)
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    span = float(max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1])))
+    for ax, (u, v, y), title in zip(axes, shapes, titles):
+        peak = max(float(np.max(np.abs(np.concatenate([u, v])))), float(np.max(np.abs(y))))
+        k = 0.12 * span / peak if peak > 0 else 0.0
+        _frame_axes(ax, members)
+        for nodes in member_nodes:
+            ax.plot(xy[nodes, 0] + k * u[nodes], xy[nodes, 1] + k * v[nodes], color="C0",
+                    lw=1.6)
+        ax.quiver(points[:, 0], points[:, 1], k * y * directions[:, 0],
+                  k * y * directions[:, 1], angles="xy", scale_units="xy", scale=1,
+                  color="C3", width=0.006)
+        ax.set_title(title, fontsize=8)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    axes[0].plot([], [], color="C0", label="model")
+    axes[0].plot([], [], color="C3", label="test (sensors)")
+    axes[0].legend(fontsize=7, loc="best")
+    return fig
+
+
+def frame_localisation(members, points, residual, worst, labels):
+    """The frame with each sensor coloured by its shape residual (rms over the pairs, in
+    each mode's largest amplitude); the largest ones named."""
+    fig = _figure(6.4, 4.6)
+    ax = fig.subplots()
+    _frame_axes(ax, members, color="0.55", lw=1.5)
+    # sensors at one point (two directions): the point shows the larger residual
+    keys = [tuple(np.round(p, 9)) for p in points]
+    top = {}
+    for i, k in enumerate(keys):
+        if k not in top or residual[i] > residual[top[k]]:
+            top[k] = i
+    shown = np.array(sorted(top.values(), key=lambda i: residual[i]))
+    sc = ax.scatter(points[shown, 0], points[shown, 1], c=residual[shown], cmap="viridis",
+                    s=46, zorder=3, edgecolors="k", linewidths=0.4)
+    fig.colorbar(sc, ax=ax, shrink=0.8, label="shape residual (of the largest amplitude)")
+    for label in worst:
+        i = labels.index(label)
+        ax.annotate(label, points[i], fontsize=7, xytext=(4, 4), textcoords="offset points")
+    ax.margins(0.15)
+    ax.set_title("where the measured shapes differ from the model's", fontsize=10)
+    return fig

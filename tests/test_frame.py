@@ -381,3 +381,33 @@ def test_gfe_opt_modes_writes_a_frame_uff_that_compares_with_its_model(tmp_path)
     assert [(p["test_mode"], p["model_mode"]) for p in pairs] == [(i, i) for i in range(1, 6)]
     # dataset 55 holds a frequency to 6 significant digits (pyuff's field): 1e-5 at most
     assert all(abs(p["error_pct"]) < 1e-3 and p["mac"] > 0.99999 for p in pairs)
+
+
+def test_frame_figures_draw_the_comparison_they_come_from(tmp_path):
+    """compare --plot on a frame: the four figures, each panel of the modes' figure titled
+    with its pair's frequencies and MAC from the same result, the localisation coloured by
+    the residual the JSON gives; an existing figure is not overwritten without --force."""
+    from gfe_opt.frame_data import compare_frame, frame_figures, load_frame_measured
+    from gfe_opt.names import FRAME_COMPARE_FIGURES
+
+    model = portal_frame()
+    measured = load_frame_measured(problem_file("portal-frame-semirigid.json"), model)
+    result = compare_frame(model, measured)
+    figs = frame_figures(result, model, measured)
+    assert set(figs) == set(FRAME_COMPARE_FIGURES)
+    titles = [ax.get_title() for ax in figs["frame_modes.png"].axes if ax.get_visible()]
+    assert titles == [f"mode {p.test_mode}: {p.test_hz:.4g} Hz test, {p.model_hz:.4g} Hz "
+                      f"model, MAC {p.mac:.3f}" for p in result.pairs]
+    colours = figs["frame_localisation.png"].axes[0].collections[0].get_array()
+    assert np.isclose(np.max(colours), np.max(result.residual))
+    frame = str(problem_file("portal-frame.toml"))
+    data = str(problem_file("portal-frame-semirigid.json"))
+    args = [sys.executable, "-m", "gfe_opt", "compare", frame, data, "--plot",
+            str(tmp_path / "figs"), "--report", str(tmp_path / "r.html")]
+    run = subprocess.run(args, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    for name in FRAME_COMPARE_FIGURES:
+        assert (tmp_path / "figs" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "r.html").read_text().count("data:image/png;base64,") == 4
+    again = subprocess.run(args, capture_output=True, text=True)
+    assert again.returncode == 2 and len(again.stderr.strip().splitlines()) == 1
