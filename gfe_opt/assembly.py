@@ -379,7 +379,12 @@ def builder(model: Model) -> Builder:
 
 
 def discretise(model: Model) -> Discretisation:
-    """Element data of ``model`` including its effects."""
+    """Element data of ``model`` including its effects (a plane frame:
+    :class:`~gfe_opt.frame.FrameDiscretisation`)."""
+    if model.kind == "frame":
+        from .frame import FrameDiscretisation
+
+        return FrameDiscretisation(model)
     return builder(model).discretisation()
 
 

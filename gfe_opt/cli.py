@@ -246,12 +246,17 @@ def _comparison_report(report, result, model, measured):
                          f"({100 * rel:.0f} % of the largest residual force).")
 
 
-def _inputs(args):
-    """The model and measured files of a command (input errors before any solver loads)."""
+def _inputs(args, frames: bool = False):
+    """The model and measured files of a command (input errors before any solver loads);
+    ``frames``: the command takes a plane frame too."""
     from .measured import load_measured
     from .model import load_model
 
-    model = load_model(args.model)
+    model = load_model(args.model, frames=frames)
+    if model.kind == "frame":
+        from .frame_data import load_frame_measured
+
+        return model, load_frame_measured(args.measured, model)
     return model, load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
 
 
@@ -405,7 +410,7 @@ def cmd_update(args) -> int:
     if not args.add and not args.drop:
         raise GfeInputError("update", None, "nothing to do: give an effect to add (--add) or "
                             "a present one to take out (--drop)")
-    model, measured = _inputs(args)
+    model, measured = _inputs(args, frames=True)
     from .model import parse_effect, save_model
 
     effects = [parse_effect(a, model) for a in args.add]
@@ -425,7 +430,8 @@ def cmd_update(args) -> int:
     else:
         print(format_update(outcome))
         if args.out:
-            print(f"updated model written to {args.out}; continue with: gfe-opt diagnose "
+            again = "compare" if model.kind == "frame" else "diagnose"
+            print(f"updated model written to {args.out}; continue with: gfe-opt {again} "
                   f"{args.out} {args.measured}")
     if args.plot or args.report:
         from .report import update_figures

@@ -1271,10 +1271,15 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     added twice, is an error.  ``drop`` takes present instances out first (their index in
     the model's effects, or a name the model holds once): a diagnosis's ``replace``."""
     noise = noise_of(freq_noise, shape_noise)
-    measured, dropped = on_model(measured, model)
-    check_model_size(_discretise(model), measured, model.source or model.name)
-    check_units(model, measured)
-    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    if model.kind == "frame":   # sensors on a frame read through its mesh
+        from .measured import observation
+
+        dropped, C = [], observation(_discretise(model), measured)
+    else:
+        measured, dropped = on_model(measured, model)
+        check_model_size(_discretise(model), measured, model.source or model.name)
+        check_units(model, measured)
+        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     before = misfit(model, measured, noise, C)
     taken = []
     if drop:
@@ -1303,7 +1308,9 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
         if getattr(kind, "fallback", False):
             starts.append(_profile_start(model, measured, e, noise))
             continue
-        if hint is None:
+        if hint is None and model.kind == "frame":
+            hint = 0.5   # no effect along a frame's members is fitted yet
+        elif hint is None:
             places = compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
             hint = places[0][0] / model.length if places else 0.5
         where = e.parameters.get("position")
@@ -1361,7 +1368,8 @@ def _default_fixed(kind, model):
     out = {}
     for key in kind.fixed_keys():
         p = kind.parameter(key)
-        out[key] = p.choices[0] if p.rule == "choice" else [0.0, model.length]
+        out[key] = ((p.choices[0] if p.choices else None) if p.rule == "choice"
+                    else [0.0, model.length])
     return out
 
 

@@ -178,7 +178,7 @@ def evaluate(model, measured, noise: Noise, C=None) -> Point | None:
         f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
         r[rows] = f_err / noise.freq
         return Point(r, f_err, None, disc, K, M, modes, rows, cols)
-    if C is None or disc.shear_g is not None:
+    if C is None or disc.shear_g is not None or disc.kind == "frame":
         C = observation(disc, measured)
     shapes = C @ modes.shapes
     mac_matrix = mac(measured.shapes, shapes)
@@ -270,6 +270,11 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
 def _max_modes(model: Model) -> int:
     from .assembly import constrained_dofs
 
+    if model.kind == "frame":
+        from .frame import frame_mesh
+
+        mesh = frame_mesh(model)
+        return mesh.n_dof - mesh.constrained.size - 1
     return model.n_dof - len(constrained_dofs(model)) - 1
 
 
@@ -521,7 +526,9 @@ def fit_problem(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     """The :class:`FitProblem` of :func:`fit_effects` (same arguments)."""
     base = model.with_effects([], check=False)
     slots = slots_for(model, adding)
-    if C is None:
+    if C is None and model.kind == "frame":
+        C = observation(discretise(model), measured)
+    elif C is None:
         C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     lower = np.array([v.lower for s in slots for v in s.variables])
     upper = np.array([v.upper for s in slots for v in s.variables])

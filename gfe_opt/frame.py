@@ -30,7 +30,7 @@ and updating them are the next parts of the issue.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -71,9 +71,34 @@ class FrameModel:
     nodes: dict
     members: tuple
     supports: tuple          # (node id, type)
-    effects: tuple = ()      # dicts: {"effect": ..., ...}
+    effects: tuple = ()      # Effect instances (a dict {"effect": name, ...} is taken too)
     source: str | None = None
     kind: str = field(default="frame")
+
+    def __post_init__(self):
+        from .model import Effect
+
+        object.__setattr__(self, "effects", tuple(
+            Effect(e["effect"], {k: v for k, v in e.items() if k != "effect"})
+            if isinstance(e, dict) else e for e in self.effects))
+
+    def with_effects(self, effects, check: bool = True) -> FrameModel:
+        """The same frame with ``effects`` (validated unless ``check`` is false)."""
+        out = replace(self, effects=tuple(effects))
+        if check:
+            for i, e in enumerate(out.effects):
+                _effect(out, {"effect": e.name, **e.parameters}, out.source or out.name,
+                        f"effects[{i}].")
+        return out
+
+    @property
+    def elements(self) -> int:
+        return self.n_elements
+
+    @property
+    def raw_effects(self) -> list[dict]:
+        """The effects as the file writes them: ``{"effect": name, **parameters}``."""
+        return [{"effect": e.name, **e.parameters} for e in self.effects]
 
     def member(self, member_id: str) -> Member:
         return next(m for m in self.members if m.id == member_id)
@@ -96,15 +121,16 @@ def frame_from_dict(data: dict, where: str = "model") -> FrameModel:
     """A :class:`FrameModel` from the parsed TOML mapping; :class:`GfeInputError` (one line:
     file, key, what is wrong) on bad input."""
     from .effects.base import no_unknown
-    from .model import _number, _table
+    from .model import _number
 
     no_unknown(data, {"name", "kind", "material", "section", "nodes", "members", "supports",
                       "effects"}, where, "")
     name = data.get("name", where.rsplit("/", 1)[-1].rsplit(".", 1)[0])
     if not isinstance(name, str):
         raise GfeInputError(where, "name", f"must be a string, got {name!r}")
-    material = _material(_table(data, "material", where), where, "material.", None)
-    section = _section(_table(data, "section", where), where, "section.", None)
+    # the defaults of every member; optional where each member has its own
+    material = _material(data.get("material", {}), where, "material.", None)
+    section = _section(data.get("section", {}), where, "section.", None)
 
     nodes = {}
     for i, raw in enumerate(_array(data, "nodes", where)):
@@ -188,7 +214,7 @@ def frame_from_dict(data: dict, where: str = "model") -> FrameModel:
         key = _effect_key(e)
         if key is not None and key in seen:
             raise GfeInputError(where, f"effects[{i}]", f"repeats effects[{seen[key]}] (one "
-                                f"{e['effect']} at one place)")
+                                f"{e.name} at one place)")
         seen.setdefault(key, i)
     return FrameModel(name=name, nodes=nodes, members=tuple(members),
                       supports=tuple(supports), effects=effects, source=where)
@@ -301,14 +327,15 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
         if member.depth is None:
             raise GfeInputError(where, prefix + "effect", "a crack needs the member's section "
                                 "depth h")
-        return {"effect": name, "member": member_id, "position": x, "depth_ratio": ratio}
+        return _as_effect({"effect": name, "member": member_id, "position": x,
+                           "depth_ratio": ratio})
     no_unknown(raw, {"effect", "member", "node", "stiffness"}, where, prefix)
     node = _ident(raw, "node", where, prefix)
     if node not in (member.start, member.end):
         raise GfeInputError(where, prefix + "node", f"member {member_id!r} does not end at "
                             f"node {node!r} (its ends: {member.start}, {member.end})")
     k = _number(raw, "stiffness", where, positive=True, prefix=prefix)
-    return {"effect": name, "member": member_id, "node": node, "stiffness": k}
+    return _as_effect({"effect": name, "member": member_id, "node": node, "stiffness": k})
 
 
 def _support_effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
@@ -340,16 +367,44 @@ def _support_effect(model: FrameModel, raw: dict, where: str, prefix: str) -> di
         raise GfeInputError(where, prefix + "node", f"the {held} support at {node!r} does "
                             f"not fix its {what}")
     out["stiffness"] = _number(raw, "stiffness", where, positive=True, prefix=prefix)
-    return out
+    return _as_effect(out)
 
 
-def _effect_key(e: dict) -> tuple | None:
+def _as_effect(raw: dict):
+    from .model import Effect
+
+    return Effect(raw["effect"], {k: v for k, v in raw.items() if k != "effect"})
+
+
+def _effect_key(effect) -> tuple | None:
     """What two instances of a frame effect may not share (a crack may repeat)."""
+    e = {"effect": effect.name, **effect.parameters}
     if e["effect"] == "joint_spring":
         return ("joint_spring", e["member"], e["node"])
     if e["effect"] == "crack":
         return None
     return (e["effect"], e["node"], e.get("direction"))
+
+
+def frame_to_dict(model: FrameModel) -> dict:
+    """The TOML mapping of a frame (inverse of :func:`frame_from_dict`): every member with
+    its own material and section (exactly as read, defaults resolved)."""
+    def section(m):
+        out = {"A": m.area, "I": m.inertia}
+        if m.depth is not None:
+            out["h"] = m.depth
+        return out
+
+    data = {"name": model.name, "kind": "frame",
+            "nodes": [{"id": n, "x": x, "y": y} for n, (x, y) in model.nodes.items()],
+            "members": [{"id": m.id, "from": m.start, "to": m.end, "elements": m.elements,
+                         "material": {"E": m.E, "rho": m.rho, "nu": m.nu},
+                         "section": section(m)} for m in model.members]}
+    if model.supports:
+        data["supports"] = [{"node": n, "type": t} for n, t in model.supports]
+    if model.effects:
+        data["effects"] = model.raw_effects
+    return data
 
 
 # ------------------------------------------------------------------------------------------
@@ -393,7 +448,7 @@ def frame_mesh(model: FrameModel) -> FrameMesh:
     n_dof = 3 * n_nodes
     springs = []
     end_theta = {}
-    for e in model.effects:
+    for e in model.raw_effects:
         if e["effect"] == "joint_spring":
             joint = ids.index(e["node"])
             end_theta[(e["member"], e["node"])] = n_dof
@@ -417,7 +472,7 @@ def frame_mesh(model: FrameModel) -> FrameMesh:
     fixed = {int(dofs[ids.index(node), d]) for node, kind in model.supports
              for d in SUPPORT_TYPES[kind]}
     grounded = []
-    for e in model.effects:
+    for e in model.raw_effects:
         if e["effect"] in ("support_spring", "support_translation"):
             dof = int(dofs[ids.index(e["node"]), RELEASES[e.get("direction", e["effect"])]])
             fixed.discard(dof)
@@ -438,7 +493,7 @@ def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
                    for k in mesh.element_member])
     out = np.stack([12.0 * EI, 6.0 * EI, 4.0 * EI], axis=1)
     for k, member in enumerate(model.members):
-        cracks = [(e["position"], e["depth_ratio"]) for e in model.effects
+        cracks = [(e["position"], e["depth_ratio"]) for e in model.raw_effects
                   if e["effect"] == "crack" and e["member"] == member.id]
         if not cracks:
             continue
@@ -517,29 +572,84 @@ def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
     return K, M
 
 
+class FrameDiscretisation:
+    """A frame's mesh and matrices behind the interface the modal solve and the fits use
+    (:class:`~gfe_opt.assembly.Discretisation`'s: ``kind``, ``free``, ``constrained``,
+    ``eigenvalue_scale``, :meth:`global_matrices`, :meth:`strain_energy`), so that a frame
+    goes through :func:`~gfe_opt.modal.discretisation_modes` and
+    :func:`~gfe_opt.fitting.fit_effects` as a beam does."""
+
+    kind = "frame"
+    shear_g = None
+
+    def __init__(self, model: FrameModel):
+        self.model = model
+        self.mesh = frame_mesh(model)
+        self.n_elements = model.n_elements
+        self.n_dof = self.mesh.n_dof
+        self.constrained = self.mesh.constrained
+        self.free = np.setdiff1d(np.arange(self.n_dof), self.constrained)
+        #: EI/(ρA L⁴) of the most flexible member: the eigenvalue scale of the frame
+        self.eigenvalue_scale = min(m.E * m.inertia / (m.rho * m.area
+                                                       * model.member_length(m) ** 4)
+                                    for m in model.members)
+        self._matrices = None
+
+    def global_matrices(self, params=None):
+        """(K, M) over all DOFs, supports not applied (``params`` must be None: a frame's
+        generic parameters are not replaced yet)."""
+        if params is not None:
+            raise ValueError("replaced generic parameters are for beams and bars")
+        if self._matrices is None:
+            self._matrices = frame_matrices(self.model, self.mesh)
+        return self._matrices
+
+    def strain_energy(self, shapes, params=None) -> np.ndarray:
+        return strain_energy(self.model, self.mesh, shapes)
+
+    def rigid_body_count(self) -> int:
+        """Rigid-body modes the supports and springs leave: the plane motions
+        (u = a − θ y, v = b + θ x, every rotation θ) that vanish at the fixed DOFs and store
+        no energy (a spring to ground takes one away)."""
+        import scipy.linalg as sla
+
+        xy = self.mesh.xy
+        n = xy.shape[0]
+        basis = np.zeros((self.n_dof, 3))
+        basis[0:3 * n:3, 0] = 1.0
+        basis[1:3 * n:3, 1] = 1.0
+        basis[0:3 * n:3, 2], basis[1:3 * n:3, 2] = -xy[:, 1], xy[:, 0]
+        basis[2:3 * n:3, 2] = 1.0
+        basis[3 * n:, 2] = 1.0                      # members' own end rotations
+        fixed = basis[self.constrained]
+        null = sla.null_space(fixed) if fixed.size else np.eye(3)
+        if null.shape[1] == 0:
+            return 0
+        motions = basis @ null
+        k = motions.shape[1]
+        pairs = np.stack([motions[:, i] + motions[:, j] for i in range(k) for j in range(k)],
+                         1)
+        energy = self.strain_energy(np.hstack([motions, pairs]))
+        single, both = energy[:k], energy[k:].reshape(k, k)
+        E = 0.5 * (both - single[:, None] - single[None, :])
+        _, M = self.global_matrices()
+        Mr = motions.T @ (M @ motions)
+        lam = sla.eigh(0.5 * (E + E.T), Mr, eigvals_only=True)
+        return int(np.sum(lam <= 1e-9 * self.eigenvalue_scale))
+
+
 def frame_modes(model: FrameModel, n_modes: int):
     """The lowest ``n_modes`` modes (:class:`~gfe_opt.modal.Modes`; shapes over all DOFs,
-    zero at the supports), rigid-body modes (0 Hz) included; checked as the beam's direct
-    route is (the relative residual of every elastic mode)."""
-    from .errors import GfeSolverError
-    from .modal import RESIDUAL_TOLERANCE, Modes, _residual, solve_modes
+    zero at the supports), rigid-body modes (0 Hz) included: the beam's direct route
+    (:func:`~gfe_opt.modal.discretisation_modes`: eigenvalues as Rayleigh quotients from
+    the element deformations, every elastic mode's residual checked)."""
+    from .modal import discretisation_modes
 
-    mesh = frame_mesh(model)
-    K, M = frame_matrices(model, mesh)
-    free = np.setdiff1d(np.arange(mesh.n_dof), mesh.constrained)
-    if not 1 <= n_modes <= free.size - 1:
-        raise GfeInputError(model.source, "modes", f"the frame has {free.size} free DOFs: "
-                            f"ask for 1 to {free.size - 1} modes, got {n_modes}")
-    ref = min(m.E * m.inertia / (m.rho * m.area * model.member_length(m) ** 4)
-              for m in model.members)
-    modes = solve_modes(K, M, n_modes, mesh.constrained, ref)
-    rigid = modes.frequencies_hz == 0
-    lam = np.where(rigid, 0.0, strain_energy(model, mesh, modes.shapes)
-                   / np.einsum("ij,ij->j", modes.shapes, M @ modes.shapes))
-    worst = _residual(K, M, modes.shapes, lam, free)
-    if worst > RESIDUAL_TOLERANCE:
-        raise GfeSolverError(f"modal solve failed its check: relative residual {worst:.2g}")
-    return Modes(frequencies_hz=np.sqrt(lam) / (2 * np.pi), shapes=modes.shapes)
+    disc = FrameDiscretisation(model)
+    if not 1 <= n_modes <= disc.free.size - 1:
+        raise GfeInputError(model.source, "modes", f"the frame has {disc.free.size} free "
+                            f"DOFs: ask for 1 to {disc.free.size - 1} modes, got {n_modes}")
+    return discretisation_modes(disc, n_modes)
 
 
 def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:

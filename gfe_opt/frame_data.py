@@ -41,6 +41,29 @@ class FrameMeasured:
     def n_modes(self) -> int:
         return self.frequencies_hz.size
 
+    @property
+    def n_sensors(self) -> int:
+        return 0 if self.shapes is None else len(self.sensors)
+
+    @property
+    def frequency_only(self) -> bool:
+        """Too few sensors for shapes to tell modes apart (as for beams)."""
+        from .measured import MIN_SHAPE_SENSORS
+
+        return self.n_sensors < MIN_SHAPE_SENSORS
+
+    @property
+    def shape_sensors(self) -> int:
+        return 0 if self.frequency_only else self.n_sensors
+
+    @property
+    def n_values(self) -> int:
+        return self.n_modes * (1 + self.shape_sensors)
+
+    @property
+    def omega(self) -> np.ndarray:
+        return 2.0 * np.pi * self.frequencies_hz
+
 
 def load_frame_measured(path, model: FrameModel) -> FrameMeasured:
     """Read frame measured modes (JSON, module docstring), each sensor checked against

@@ -615,7 +615,13 @@ def _shear_sensor_parts(n_el, L, e_bytes, xi_bytes):
 
 
 def observation(disc, measured) -> sp.csr_matrix:
-    """:func:`sensor_matrix` of a discretisation (its Timoshenko g, if any) and a test."""
+    """:func:`sensor_matrix` of a discretisation (its Timoshenko g, if any) and a test; a
+    frame's sensors read through its mesh (:func:`gfe_opt.frame_data.observation`: a joint
+    spring gives a member's end its own rotation, so the matrix follows the effects)."""
+    if disc.kind == "frame":
+        from .frame_data import observation as frame_observation
+
+        return frame_observation(disc.model, disc.mesh, measured.sensors)
     return sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source,
                          shear_g=getattr(disc, "shear_g", None))
 

@@ -331,6 +331,8 @@ def rigid_body_count(disc: Discretisation) -> int:
     """How many rigid-body modes (ω = 0) the supports and springs leave: the motions
     w = a + b x, θ = b (bar: u = a) that vanish at the constrained DOFs and store no strain
     energy (a foundation or a spring to ground takes them away)."""
+    if disc.kind == "frame":
+        return disc.rigid_body_count()
     x = disc.nodes
     if disc.kind == "beam":
         basis = np.zeros((disc.n_dof, 2))

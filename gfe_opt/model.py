@@ -167,9 +167,10 @@ def load_model(path, *, frames: bool = False) -> Model:
         raise GfeInputError(where, None, "not valid TOML (nested too deeply)") from None
     if isinstance(data, dict) and data.get("kind") == "frame":
         if not frames:
-            raise GfeInputError(where, "kind", "a plane frame: gfe-opt computes its modes and "
-                                "compares them with a test so far (gfe-opt modes, gfe-opt "
-                                "compare); diagnose, update, batch and demo take beams and bars")
+            raise GfeInputError(where, "kind", "a plane frame: gfe-opt computes its modes, "
+                                "compares them with a test and updates it so far (gfe-opt "
+                                "modes, compare, update --add joint_spring:node=...,member=...)"
+                                "; diagnose, batch and demo take beams and bars")
         from .frame import frame_from_dict
 
         return frame_from_dict(data, where)
@@ -380,7 +381,12 @@ def _table(data, key, where):
 
 
 def model_to_dict(model: Model) -> dict:
-    """The TOML mapping of a model (inverse of :func:`model_from_dict`)."""
+    """The TOML mapping of a model (inverse of :func:`model_from_dict`; a plane frame's of
+    :func:`gfe_opt.frame.frame_from_dict`)."""
+    if model.kind == "frame":
+        from .frame import frame_to_dict
+
+        return frame_to_dict(model)
     data = {"name": model.name, "kind": model.kind, "length": model.length,
             "elements": model.elements}
     if model.mass_model != "consistent":

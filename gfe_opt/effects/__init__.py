@@ -73,6 +73,7 @@ def _register_builtins():
         axial_load,
         crack,
         foundation,
+        joint_spring,
         mass_profile,
         material,
         point_mass,
@@ -86,7 +87,7 @@ def _register_builtins():
 
     for module in (material, crack, section_loss, shear, axial_load, foundation,
                    support_spring, support_translation, point_spring, point_mass,
-                   stiffness_profile, mass_profile):
+                   stiffness_profile, mass_profile, joint_spring):
         register_effect(module.EFFECT)
 
 
