@@ -25,10 +25,11 @@ from . import elements as el
 from .correlation import PairSummary
 from .errors import GfeInputError, GfeSolverError
 from .frame import FrameMesh, FrameModel, frame_mesh, frame_modes
+from .measured import ModeCounts
 
 
 @dataclass(frozen=True)
-class FrameMeasured:
+class FrameMeasured(ModeCounts):
     """Measured modes of a frame: sensors (dicts of the contract), frequencies [Hz] and
     shapes (n_sensors, n_modes; None for frequencies only)."""
 
@@ -38,31 +39,8 @@ class FrameMeasured:
     source: str = "measured"
 
     @property
-    def n_modes(self) -> int:
-        return self.frequencies_hz.size
-
-    @property
     def n_sensors(self) -> int:
         return 0 if self.shapes is None else len(self.sensors)
-
-    @property
-    def frequency_only(self) -> bool:
-        """Too few sensors for shapes to tell modes apart (as for beams)."""
-        from .measured import MIN_SHAPE_SENSORS
-
-        return self.n_sensors < MIN_SHAPE_SENSORS
-
-    @property
-    def shape_sensors(self) -> int:
-        return 0 if self.frequency_only else self.n_sensors
-
-    @property
-    def n_values(self) -> int:
-        return self.n_modes * (1 + self.shape_sensors)
-
-    @property
-    def omega(self) -> np.ndarray:
-        return 2.0 * np.pi * self.frequencies_hz
 
 
 def load_frame_measured(path, model: FrameModel) -> FrameMeasured:
@@ -105,16 +83,10 @@ def _read_frame_uff(path, model: FrameModel) -> FrameMeasured:
     one dataset 55 (normal mode) per mode with the x and y components in r1 and r2.  Each
     node is placed on the frame (:func:`locate`); each of its two components that is not
     zero in every mode is a sensor in that direction."""
-    from .measured import read_uff_sets
+    from .measured import uff_modes
 
     where = str(path)
-    sets, coords = read_uff_sets(path, plane=True)
-    modes = [s for s in sets if s.get("type") == 55 and s.get("analysis_type") == 2]
-    if not coords:
-        raise GfeInputError(where, "dataset 15/2411", "no node coordinates found")
-    if not modes:
-        raise GfeInputError(where, "dataset 55", "no normal-mode data (analysis type 2) found")
-    nodes = [int(n) for n in np.asarray(modes[0]["node_nums"]).astype(int)]
+    modes, coords, nodes = uff_modes(path, plane=True)
     for i, m in enumerate(modes):
         if [int(n) for n in np.asarray(m["node_nums"]).astype(int)] != nodes:
             raise GfeInputError(where, f"dataset 55 #{i + 1}", "nodes differ from the first "

@@ -52,30 +52,13 @@ MIN_SHAPE_SENSORS = 3
 MAX_FREQUENCY_HZ = 1e8
 
 
-@dataclass(frozen=True)
-class MeasuredModes:
-    """Measured natural frequencies (n_modes,) [Hz] and shapes (n_sensors, n_modes).
-
-    ``x`` holds the sensor positions [m] from the left end, ``dof`` the measured direction
-    (``"w"`` transverse, ``"u"`` axial).
-    """
-
-    x: np.ndarray
-    dof: str
-    frequencies_hz: np.ndarray
-    shapes: np.ndarray
-    source: str = "measured"
-    damping: np.ndarray | None = None
-    time: str | float | None = None    # when the test was made (ISO 8601 text or a number)
-    label: str | None = None           # a name for the test (batch tables and trends)
+class ModeCounts:
+    """What a fit counts of a test (``frequencies_hz`` and ``n_sensors`` given by the
+    class): modes, whether shapes are used, residuals."""
 
     @property
     def n_modes(self) -> int:
         return len(self.frequencies_hz)
-
-    @property
-    def n_sensors(self) -> int:
-        return len(self.x)
 
     @property
     def frequency_only(self) -> bool:
@@ -92,6 +75,32 @@ class MeasuredModes:
         """Measured values compared with a model: frequencies and, if used, shapes."""
         return self.n_modes * (1 + self.shape_sensors)
 
+    @property
+    def omega(self) -> np.ndarray:
+        return 2.0 * np.pi * self.frequencies_hz
+
+
+@dataclass(frozen=True)
+class MeasuredModes(ModeCounts):
+    """Measured natural frequencies (n_modes,) [Hz] and shapes (n_sensors, n_modes).
+
+    ``x`` holds the sensor positions [m] from the left end, ``dof`` the measured direction
+    (``"w"`` transverse, ``"u"`` axial).
+    """
+
+    x: np.ndarray
+    dof: str
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    source: str = "measured"
+    damping: np.ndarray | None = None
+    time: str | float | None = None    # when the test was made (ISO 8601 text or a number)
+    label: str | None = None           # a name for the test (batch tables and trends)
+
+    @property
+    def n_sensors(self) -> int:
+        return len(self.x)
+
     def without_shapes_note(self) -> str | None:
         """Why the shapes are not used, or None."""
         if not self.frequency_only:
@@ -102,9 +111,6 @@ class MeasuredModes:
         return (f"{what}: modes paired by frequency (nearest, one to one) and only "
                 "frequencies compared; MAC and where the model fails are unavailable")
 
-    @property
-    def omega(self) -> np.ndarray:
-        return 2.0 * np.pi * self.frequencies_hz
 
 
 def make_measured(x, dof, frequencies_hz, shapes, source="measured",
@@ -419,15 +425,22 @@ def read_uff_sets(path: Path, plane: bool = False) -> tuple[list, dict]:
     return sets, coords
 
 
-def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
+def uff_modes(path, plane: bool = False) -> tuple[list, dict, list]:
+    """The normal-mode datasets 55 of a universal file, its node coordinates
+    (:func:`read_uff_sets`) and the first mode's node numbers; none of either is one line."""
     where = str(path)
-    sets, coords = read_uff_sets(path)
+    sets, coords = read_uff_sets(path, plane=plane)
     modes = [s for s in sets if s.get("type") == 55 and s.get("analysis_type") == 2]
     if not coords:
         raise GfeInputError(where, "dataset 15/2411", "no node coordinates found")
     if not modes:
         raise GfeInputError(where, "dataset 55", "no normal-mode data (analysis type 2) found")
-    nodes = [int(n) for n in np.asarray(modes[0]["node_nums"]).astype(int)]
+    return modes, coords, [int(n) for n in np.asarray(modes[0]["node_nums"]).astype(int)]
+
+
+def _read_uff(path: Path, dof: str | None) -> MeasuredModes:
+    where = str(path)
+    modes, coords, nodes = uff_modes(path)
     missing = [n for n in nodes if n not in coords]
     if missing:
         raise GfeInputError(where, "dataset 55", f"node {missing[0]} has no coordinates")
