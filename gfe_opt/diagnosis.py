@@ -1292,6 +1292,10 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
                                      partial=True)
     check_repeats([*model.effects, *effects], "--add", "effects")
+    if model.kind == "frame":   # one joint spring a member end, as in a frame file
+        from .frame import check_repeats as check_frame_repeats
+
+        check_frame_repeats([*model.effects, *effects], "--add")
     check_enough_modes(measured, [*model.effects, *effects])
     hint = None
     starts = []

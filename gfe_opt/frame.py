@@ -89,6 +89,7 @@ class FrameModel:
             for i, e in enumerate(out.effects):
                 _effect(out, {"effect": e.name, **e.parameters}, out.source or out.name,
                         f"effects[{i}].")
+            check_repeats(out.effects, out.source or out.name)
         return out
 
     @property
@@ -209,13 +210,7 @@ def frame_from_dict(data: dict, where: str = "model") -> FrameModel:
                        supports=tuple(supports), source=where)
     effects = tuple(_effect(model, raw, where, f"effects[{i}].")
                     for i, raw in enumerate(_array(data, "effects", where, required=False)))
-    seen = {}
-    for i, e in enumerate(effects):
-        key = _effect_key(e)
-        if key is not None and key in seen:
-            raise GfeInputError(where, f"effects[{i}]", f"repeats effects[{seen[key]}] (one "
-                                f"{e.name} at one place)")
-        seen.setdefault(key, i)
+    check_repeats(effects, where)
     return FrameModel(name=name, nodes=nodes, members=tuple(members),
                       supports=tuple(supports), effects=effects, source=where)
 
@@ -374,6 +369,17 @@ def _as_effect(raw: dict):
     from .model import Effect
 
     return Effect(raw["effect"], {k: v for k, v in raw.items() if k != "effect"})
+
+
+def check_repeats(effects, where) -> None:
+    """One joint spring a member end, one support effect a node and direction."""
+    seen = {}
+    for i, e in enumerate(effects):
+        key = _effect_key(e)
+        if key is not None and key in seen:
+            raise GfeInputError(where, f"effects[{i}]", f"repeats effects[{seen[key]}] (one "
+                                f"{e.name} at one place)")
+        seen.setdefault(key, i)
 
 
 def _effect_key(effect) -> tuple | None:
