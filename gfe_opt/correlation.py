@@ -431,22 +431,7 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
                                   / measured.frequencies_hz[t]),
                   mac=float(mac_matrix[t, m])) for t, m in pairs_idx]
     notes = list(dropped)
-    # a shape pair 20 times off in frequency is not the same mode (with few sensors a high
-    # model mode can look like a low one: a pin that gives on a clamped-pinned beam, 3
-    # sensors, paired its 1537 Hz mode with 59 kHz): left unpaired, said; the test's units
-    # are refused only when no pair is plausible (the median check above catches the rest)
-    far = [p for p in pairs if not 0.05 <= p.test_hz / p.model_hz <= 20.0]
-    if far and len(far) == len(pairs):
-        p = far[0]
-        raise GfeInputError(measured.source, f"modes[{p.test_mode - 1}].frequency",
-                            f"{p.test_hz:.4g} Hz is {p.test_hz / p.model_hz:.3g} times the "
-                            f"frequency of the model mode its shape pairs with "
-                            f"({p.model_hz:.4g} Hz): a typo or wrong units?")
-    for p in far:
-        notes.append(f"test mode {p.test_mode} ({p.test_hz:.4g} Hz) is most like model mode "
-                     f"{p.model_mode} in shape, but at {p.model_hz:.4g} Hz it cannot be the "
-                     "same mode: left unpaired")
-    pairs = [p for p in pairs if p not in far]
+    pairs, far = plausible(pairs, measured.source, notes)
     pairs_idx = [(p.test_mode - 1, p.model_mode - 1) for p in pairs]
     unpaired = sorted(set(range(measured.n_modes)) - {t for t, _ in pairs_idx})
     if unpaired and len(unpaired) > len(far):
@@ -465,6 +450,26 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
                                                        at_sensors[:, m_idx]),
                       residual=residual, residual_per_mode=expansion.relative_residual,
                       model_modes=modes, expanded_shapes=expansion.shapes, notes=notes)
+
+
+def plausible(pairs, source, notes) -> tuple[list, list]:
+    """The shape pairs whose frequencies are within 20 times of each other, and the others.
+    A shape pair 20 times off in frequency is not the same mode (with few sensors a high
+    model mode can look like a low one: a pin that gives on a clamped-pinned beam, 3
+    sensors, paired its 1537 Hz mode with 59 kHz): left unpaired, said in ``notes``; the
+    test's units are refused only when no pair is plausible."""
+    far = [p for p in pairs if not 0.05 <= p.test_hz / p.model_hz <= 20.0]
+    if far and len(far) == len(pairs):
+        p = far[0]
+        raise GfeInputError(source, f"modes[{p.test_mode - 1}].frequency",
+                            f"{p.test_hz:.4g} Hz is {p.test_hz / p.model_hz:.3g} times the "
+                            f"frequency of the model mode its shape pairs with "
+                            f"({p.model_hz:.4g} Hz): a typo or wrong units?")
+    for p in far:
+        notes.append(f"test mode {p.test_mode} ({p.test_hz:.4g} Hz) is most like model mode "
+                     f"{p.model_mode} in shape, but at {p.model_hz:.4g} Hz it cannot be the "
+                     "same mode: left unpaired")
+    return [p for p in pairs if p not in far], far
 
 
 def _compare_frequencies(measured: MeasuredModes, modes: Modes, notes) -> Comparison:

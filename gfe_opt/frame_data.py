@@ -276,7 +276,14 @@ def compare_frame(model: FrameModel, measured: FrameMeasured,
     without shapes), frequency errors, and each sensor's shape residual: the rms over the
     pairs of (y − a φ)/max|y|, y the measured shape and a φ the model's at the sensors scaled
     to it by least squares."""
-    from .correlation import DEFAULT_MAC_THRESHOLD, Pair, mac, pair_by_frequency, pair_modes
+    from .correlation import (
+        DEFAULT_MAC_THRESHOLD,
+        Pair,
+        mac,
+        pair_by_frequency,
+        pair_modes,
+        plausible,
+    )
 
     threshold = DEFAULT_MAC_THRESHOLD if mac_threshold is None else mac_threshold
     mesh = frame_mesh(model)
@@ -300,6 +307,9 @@ def compare_frame(model: FrameModel, measured: FrameMeasured,
                   mac=None if mac_matrix is None else float(mac_matrix[t, m]))
              for t, m in idx]
     notes = []
+    if mac_matrix is not None:   # a shape pair 20 times off in frequency: not one mode
+        pairs, _ = plausible(pairs, measured.source, notes)
+        idx = [(p.test_mode - 1, p.model_mode - 1) for p in pairs]
     unpaired = sorted(set(range(measured.n_modes)) - {t for t, _ in idx})
     if unpaired:
         notes.append(f"test mode(s) {[u + 1 for u in unpaired]} have no model mode with "

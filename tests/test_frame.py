@@ -281,6 +281,13 @@ def test_cli_compare_on_a_frame(tmp_path):
     text = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(path)],
                           capture_output=True, text=True)
     assert text.returncode == 0 and "the shapes differ most at" in text.stdout
+    kilo = json.loads(json.dumps(data))
+    for m in kilo["modes"]:
+        m["frequency"] *= 1000.0            # Hz written as mHz: refused, not paired
+    path.write_text(json.dumps(kilo))
+    units = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(path)],
+                           capture_output=True, text=True)
+    assert units.returncode == 2 and "wrong units" in units.stderr
     data["sensors"][3]["member"] = "roof"
     path.write_text(json.dumps(data))
     bad = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(path)],
