@@ -487,6 +487,9 @@ def test_cli_update_on_a_frame(tmp_path):
                           "joint_spring:node=A,member=beam"], capture_output=True, text=True)
     assert bad.returncode == 2 and "does not end at node 'A'" in bad.stderr
     assert len(bad.stderr.strip().splitlines()) == 1
+    crack = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
+                            "crack"], capture_output=True, text=True)
+    assert crack.returncode == 2 and "not fitted on frames yet" in crack.stderr
     twice = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data] + [
         "--add", "joint_spring:node=B,member=beam"] * 2, capture_output=True, text=True)
     assert twice.returncode == 2 and "repeats" in twice.stderr

@@ -259,6 +259,9 @@ class EffectType:
                  partial: bool = False) -> dict:
         """Checked parameters (every key, or with ``partial`` those given); raises
         :class:`GfeInputError` naming the field and the allowed range."""
+        if model.kind == "frame" and model.kind not in self.kinds:
+            raise GfeInputError(where, f"{prefix}effect", f"effect {self.name!r} is not "
+                                "fitted on frames yet (a frame's update takes joint_spring)")
         if model.kind not in self.kinds:
             raise GfeInputError(where, f"{prefix}effect", f"effect {self.name!r} needs kind = "
                                 f"{' or '.join(repr(k) for k in self.kinds)}")
