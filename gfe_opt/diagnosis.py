@@ -1271,10 +1271,8 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     added twice, is an error.  ``drop`` takes present instances out first (their index in
     the model's effects, or a name the model holds once): a diagnosis's ``replace``."""
     noise = noise_of(freq_noise, shape_noise)
-    if model.kind == "frame":   # sensors on a frame read through its mesh
-        from .measured import observation
-
-        dropped, C = [], observation(_discretise(model), measured)
+    if model.kind == "frame":   # sensors on a frame read through its mesh, per model
+        dropped, C = [], None
     else:
         measured, dropped = on_model(measured, model)
         check_model_size(_discretise(model), measured, model.source or model.name)

@@ -165,7 +165,7 @@ def evaluate(model, measured, noise: Noise, C=None) -> Point | None:
     if the solve fails."""
     try:
         disc = discretise(model)
-        n_model = min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(model))
+        n_model = min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(model, disc))
         K, M = disc.global_matrices()
         modes = discretisation_modes(disc, n_model, matrices=(K, M))
     except (GfeSolverError, ValueError, np.linalg.LinAlgError):
@@ -267,14 +267,11 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
     return J.reshape(-1, n)
 
 
-def _max_modes(model: Model) -> int:
+def _max_modes(model: Model, disc) -> int:
     from .assembly import constrained_dofs
 
     if model.kind == "frame":
-        from .frame import frame_mesh
-
-        mesh = frame_mesh(model)
-        return mesh.n_dof - mesh.constrained.size - 1
+        return disc.free.size - 1
     return model.n_dof - len(constrained_dofs(model)) - 1
 
 
@@ -526,9 +523,7 @@ def fit_problem(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     """The :class:`FitProblem` of :func:`fit_effects` (same arguments)."""
     base = model.with_effects([], check=False)
     slots = slots_for(model, adding)
-    if C is None and model.kind == "frame":
-        C = observation(discretise(model), measured)
-    elif C is None:
+    if C is None and model.kind != "frame":   # a frame's: per model (evaluate)
         C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
     lower = np.array([v.lower for s in slots for v in s.variables])
     upper = np.array([v.upper for s in slots for v in s.variables])

@@ -23,8 +23,9 @@ Model file (``kind = "frame"``; README "Plane frames")::
                  effect = "support_spring": node, stiffness (N m/rad; a support's rotation)
                  effect = "support_translation": node, direction = "x" | "y", stiffness (N/m)
 
-So far frames have modes (:func:`frame_modes`, ``gfe-opt modes``); comparing, diagnosing
-and updating them are the next parts of the issue.
+Frames have modes (:func:`frame_modes`, ``gfe-opt modes``), are compared with tests
+(:mod:`gfe_opt.frame_data`) and go through the beam's fits (:class:`FrameDiscretisation`:
+``update --add joint_spring``); diagnosing them is the next part of the issue.
 """
 
 from __future__ import annotations
@@ -42,8 +43,6 @@ SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roll
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
-#: a crack's Christides–Barr disturbance is below 1e-15 beyond this many decay lengths
-CRACK_REACH = 18.0
 
 
 @dataclass(frozen=True)
@@ -65,7 +64,7 @@ class Member:
 @dataclass(frozen=True)
 class FrameModel:
     """A plane frame: named nodes (x, y in m), members between them, supports, effects
-    (dicts as in the file, validated)."""
+    (:class:`~gfe_opt.model.Effect`, validated)."""
 
     name: str
     nodes: dict
@@ -122,7 +121,7 @@ def frame_from_dict(data: dict, where: str = "model") -> FrameModel:
     """A :class:`FrameModel` from the parsed TOML mapping; :class:`GfeInputError` (one line:
     file, key, what is wrong) on bad input."""
     from .effects.base import no_unknown
-    from .model import _number
+    from .model import _number, check_section_size
 
     no_unknown(data, {"name", "kind", "material", "section", "nodes", "members", "supports",
                       "effects"}, where, "")
@@ -178,7 +177,7 @@ def frame_from_dict(data: dict, where: str = "model") -> FrameModel:
         if sec is None:
             raise GfeInputError(where, key + "section", "no section: give [section] or "
                                 "[members.section]")
-        _check_fits(sec, length, where, key + "section")
+        check_section_size(sec[0], sec[1], length, "member", where, key + "section")
         members.append(Member(member_id, ends[0], ends[1], n, *mat, *sec))
     if not members:
         raise GfeInputError(where, "members", "a frame needs at least one member")
@@ -235,7 +234,7 @@ def _ident(raw, key, where, prefix) -> str:
 def _material(tbl, where, prefix, default):
     """(E, rho, nu), each missing key from ``default``; None if neither gives E and rho."""
     from .effects.base import no_unknown
-    from .model import _number
+    from .model import _number, check_poisson, check_stiffness_density
 
     if not isinstance(tbl, dict):
         raise GfeInputError(where, prefix.rstrip("."), "must be a table")
@@ -248,15 +247,8 @@ def _material(tbl, where, prefix, default):
     if "E" not in out or "rho" not in out:
         missing = "E" if "E" not in out else "rho"
         raise GfeInputError(where, prefix + missing, "missing")
-    if not 1e7 <= out["E"] <= 1e13:
-        raise GfeInputError(where, prefix + "E", f"{out['E']:g} Pa is outside 1e7..1e13 Pa: "
-                            "give E in Pa (210e9 for steel)")
-    if not 100.0 <= out["rho"] <= 30000.0:
-        raise GfeInputError(where, prefix + "rho", f"{out['rho']:g} kg/m^3 is outside "
-                            "100..30000: give the density in kg/m^3")
-    if not -1.0 < out["nu"] < 0.5:
-        raise GfeInputError(where, prefix + "nu", f"Poisson's ratio must lie in (-1, 0.5), "
-                            f"got {out['nu']}")
+    check_stiffness_density(out["E"], out["rho"], where, prefix)
+    check_poisson(out["nu"], where, prefix + "nu")
     return out["E"], out["rho"], out["nu"]
 
 
@@ -282,15 +274,6 @@ def _section(tbl, where, prefix, default):
     h = _number(tbl, "h", where, positive=True, prefix=prefix) if "h" in tbl else None
     return (_number(tbl, "A", where, positive=True, prefix=prefix),
             _number(tbl, "I", where, positive=True, prefix=prefix), h)
-
-
-def _check_fits(section, length, where, key) -> None:
-    area, inertia, _ = section
-    size, gyration = math.sqrt(area) / length, math.sqrt(inertia / area) / length
-    if not (1e-5 <= size <= 1.0 and 1e-6 <= gyration <= 1.0):
-        raise GfeInputError(where, key, f"A = {area:g} m^2 and I = {inertia:g} m^4 do not fit "
-                            f"a {length:g} m long member (√A and √(I/A) between 1e-5 and 1 of "
-                            "its length): is the section in metres?")
 
 
 def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
@@ -503,6 +486,8 @@ def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
                   if e["effect"] == "crack" and e["member"] == member.id]
         if not cracks:
             continue
+        from .effects.crack import CRACK_REACH
+
         half = member.depth / 2.0
         decay = half / (2.0 * el.SHEN_PIERRE_GAMMA)
         ei0 = member.E * member.inertia
@@ -551,14 +536,21 @@ def element_matrices(model: FrameModel, mesh: FrameMesh):
     mass = (rhoA * L)[:, None, None] * el.symmetric_beam_mass(
         **{k: np.full(n, v) for k, v in el.CONSISTENT_BEAM_MASS.items()})
     local_m[np.ix_(range(n), bend, bend)] = mass * scaling[:, :, None] * scaling[:, None, :]
-    c, s = mesh.cosines[:, 0], mesh.cosines[:, 1]
-    T = np.zeros((n, 6, 6))
+    T = rotations(mesh.cosines)
+    Tt = np.swapaxes(T, 1, 2)
+    return Tt @ local_k @ T, Tt @ local_m @ T
+
+
+def rotations(cosines) -> np.ndarray:
+    """(n, 6, 6): T = diag(R, R), R = [[c, s, 0], [-s, c, 0], [0, 0, 1]], from global to
+    member axes, for each row (c, s) of ``cosines``."""
+    c, s = cosines[:, 0], cosines[:, 1]
+    T = np.zeros((len(cosines), 6, 6))
     for o in (0, 3):
         T[:, o, o], T[:, o, o + 1] = c, s
         T[:, o + 1, o], T[:, o + 1, o + 1] = -s, c
         T[:, o + 2, o + 2] = 1.0
-    Tt = np.swapaxes(T, 1, 2)
-    return Tt @ local_k @ T, Tt @ local_m @ T
+    return T
 
 
 def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
@@ -644,14 +636,15 @@ class FrameDiscretisation:
         return int(np.sum(lam <= 1e-9 * self.eigenvalue_scale))
 
 
-def frame_modes(model: FrameModel, n_modes: int):
+def frame_modes(model: FrameModel, n_modes: int, disc: FrameDiscretisation | None = None):
     """The lowest ``n_modes`` modes (:class:`~gfe_opt.modal.Modes`; shapes over all DOFs,
     zero at the supports), rigid-body modes (0 Hz) included: the beam's direct route
     (:func:`~gfe_opt.modal.discretisation_modes`: eigenvalues as Rayleigh quotients from
-    the element deformations, every elastic mode's residual checked)."""
+    the element deformations, every elastic mode's residual checked); ``disc`` may pass the
+    model's discretisation already built."""
     from .modal import discretisation_modes
 
-    disc = FrameDiscretisation(model)
+    disc = FrameDiscretisation(model) if disc is None else disc
     if not 1 <= n_modes <= disc.free.size - 1:
         raise GfeInputError(model.source, "modes", f"the frame has {disc.free.size} free "
                             f"DOFs: ask for 1 to {disc.free.size - 1} modes, got {n_modes}")
@@ -714,9 +707,9 @@ def write_frame_modes(model: FrameModel, n_modes: int, path, *, force: bool = Fa
     if suffix not in (".json", ".uff", ".unv"):
         raise GfeInputError(str(path), None, "a frame's modes are written as .json or "
                             ".uff/.unv (CSV for frames is not there yet)")
-    mesh = frame_mesh(model)
-    free = mesh.n_dof - mesh.constrained.size
-    modes = frame_modes(model, min(n_modes + 3, free - 1))
+    disc = FrameDiscretisation(model)
+    mesh = disc.mesh
+    modes = frame_modes(model, min(n_modes + 3, disc.free.size - 1), disc)
     elastic = np.flatnonzero(modes.frequencies_hz > 0)[:n_modes]
     sensors = mesh_sensors(model, mesh)
     doc = {"sensors": [s for s, _ in sensors],

@@ -24,7 +24,14 @@ import scipy.sparse as sp
 from . import elements as el
 from .correlation import PairSummary
 from .errors import GfeInputError, GfeSolverError
-from .frame import FrameMesh, FrameModel, frame_mesh, frame_modes
+from .frame import (
+    FrameDiscretisation,
+    FrameMesh,
+    FrameModel,
+    frame_mesh,
+    frame_modes,
+    rotations,
+)
 from .measured import ModeCounts
 
 
@@ -209,17 +216,11 @@ def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
         j = min(int(s["position"] // L), member.elements - 1)
         xi = s["position"] / L - j
         e = int(np.flatnonzero(mesh.element_member == k)[0]) + j
-        c, sn = mesh.cosines[e]
-        R = np.array([[c, sn], [-sn, c]])            # global -> member axes
-        n_ax = el.linear(xi)                          # axial: u at the ends
-        n_tr = el.hermite(xi) * el.beam_dof_scaling(L)   # across: v, θ at the ends
+        T = rotations(mesh.cosines[e:e + 1])[0]       # global -> member axes
+        R = T[:2, :2]
         local = np.zeros((2, 6))                     # (axial, transverse) from local DOFs
-        local[0, [0, 3]] = n_ax
-        local[1, [1, 2, 4, 5]] = n_tr
-        T = np.zeros((6, 6))
-        for o in (0, 3):
-            T[o:o + 2, o:o + 2] = R
-            T[o + 2, o + 2] = 1.0
+        local[0, [0, 3]] = el.linear(xi)             # axial: u at the ends
+        local[1, [1, 2, 4, 5]] = el.hermite(xi) * el.beam_dof_scaling(L)  # across: v, θ
         row = d @ R.T @ local @ T                     # direction · (global displacement)
         rows += [i] * 6
         cols += mesh.element_dofs[e].tolist()
@@ -286,9 +287,9 @@ def compare_frame(model: FrameModel, measured: FrameMeasured,
     )
 
     threshold = DEFAULT_MAC_THRESHOLD if mac_threshold is None else mac_threshold
-    mesh = frame_mesh(model)
-    free = mesh.n_dof - mesh.constrained.size
-    modes = frame_modes(model, min(2 * measured.n_modes + 6, free - 1))
+    disc = FrameDiscretisation(model)
+    mesh = disc.mesh
+    modes = frame_modes(model, min(2 * measured.n_modes + 6, disc.free.size - 1), disc)
     f_model = modes.frequencies_hz
     if measured.shapes is None:
         idx = pair_by_frequency(measured.frequencies_hz, f_model)

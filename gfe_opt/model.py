@@ -205,9 +205,7 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
     E = _number(material, "E", where, positive=True, prefix="material.")
     rho = _number(material, "rho", where, positive=True, prefix="material.")
     nu = _number(material, "nu", where, prefix="material.", default=0.3)
-    if not -1.0 < nu < 0.5:
-        raise GfeInputError(where, "material.nu",
-                            f"Poisson's ratio must lie in (-1, 0.5), got {nu}")
+    check_poisson(nu, where, "material.nu")
 
     section = _table(data, "section", where)
     depth = breadth = None
@@ -243,18 +241,9 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
                             f"(known for a {kind}: {', '.join(mass_models)})")
 
     _check_proportions(length, breadth, depth, where)
-    size = math.sqrt(area) / length if math.isfinite(area) else math.inf
-    gyration = math.sqrt(inertia / area) / length if kind == "beam" and size > 0 else 0.5
-    if not (1e-5 <= size <= 1.0 and 1e-6 <= gyration <= 1.0):
-        raise GfeInputError(where, "section", f"A = {area:g} m^2 and I = {inertia:g} m^4 do "
-                            f"not fit a {length:g} m long {kind} (√A and √(I/A) between 1e-5 "
-                            "and 1 of the length): is the section in metres?")
-    if not 1e7 <= E <= 1e13:
-        raise GfeInputError(where, "material.E", f"{E:g} Pa is outside 1e7..1e13 Pa: give E in "
-                            "Pa (206e9 for steel, not 206 or 206e3)")
-    if not 100.0 <= rho <= 30000.0:
-        raise GfeInputError(where, "material.rho", f"{rho:g} kg/m^3 is outside 100..30000: "
-                            "give the density in kg/m^3")
+    check_section_size(area, inertia if kind == "beam" else None, length, kind, where,
+                       "section")
+    check_stiffness_density(E, rho, where, "material.")
     model = Model(name=name, kind=kind, length=length, elements=elements, E=E, rho=rho, nu=nu,
                   area=area, inertia=inertia, supports=supports, depth=depth, breadth=breadth,
                   mass_model=mass_model, source=where)
@@ -273,6 +262,32 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         effects.append(Effect(name_, validate_effect(model, name_, raw, where, f"effects[{i}].")))
     check_repeats(effects, where)
     return replace(model, effects=tuple(effects))
+
+
+def check_poisson(nu, where, key) -> None:
+    if not -1.0 < nu < 0.5:
+        raise GfeInputError(where, key, f"Poisson's ratio must lie in (-1, 0.5), got {nu}")
+
+
+def check_stiffness_density(E, rho, where, prefix) -> None:
+    """E and ρ in SI units (a wrong unit, not a material, otherwise)."""
+    if not 1e7 <= E <= 1e13:
+        raise GfeInputError(where, prefix + "E", f"{E:g} Pa is outside 1e7..1e13 Pa: give E in "
+                            "Pa (206e9 for steel, not 206 or 206e3)")
+    if not 100.0 <= rho <= 30000.0:
+        raise GfeInputError(where, prefix + "rho", f"{rho:g} kg/m^3 is outside 100..30000: "
+                            "give the density in kg/m^3")
+
+
+def check_section_size(area, inertia, length, what, where, key) -> None:
+    """√A and (with ``inertia``) √(I/A) between 1e-5 (1e-6) and 1 of a ``length`` m long
+    ``what`` (a section in another unit, otherwise)."""
+    size = math.sqrt(area) / length if math.isfinite(area) else math.inf
+    gyration = math.sqrt(inertia / area) / length if inertia is not None and size > 0 else 0.5
+    if not (1e-5 <= size <= 1.0 and 1e-6 <= gyration <= 1.0):
+        raise GfeInputError(where, key, f"A = {area:g} m^2 and I = {inertia or 0.0:g} m^4 do "
+                            f"not fit a {length:g} m long {what} (√A and √(I/A) between 1e-5 "
+                            "and 1 of the length): is the section in metres?")
 
 
 def _check_proportions(length, breadth, depth, where) -> None:

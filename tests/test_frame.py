@@ -462,7 +462,8 @@ def test_joint_spring_jacobian_is_the_central_difference_of_the_residual():
     measured = load_frame_measured(problem_file("portal-frame-semirigid.json"), model)
     effects = [Effect("joint_spring", {"node": "B", "member": "beam", "stiffness": 3000.0})]
     problem = fit_problem(model, measured, effects, noise=noise_of(0.0005, 0.003))
-    z = np.array([np.log10(3000.0 / (4 * 875.0 / 0.4))])
+    beam = model.member("beam")
+    z = np.array([np.log10(3000.0 / (4 * beam.E * beam.inertia / model.member_length(beam)))])
     r = problem.residual(z)
     J = problem.residual.jacobian(z, r, problem.lower, problem.upper)
     h = 1e-4
