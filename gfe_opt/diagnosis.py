@@ -154,7 +154,13 @@ def shape_correlation(model: Model, measured: MeasuredModes, noise: Noise, C=Non
     r = residuals(model, measured, noise, C)[0]
     if r is None:
         return 1.0
-    shapes = r.reshape(measured.n_modes, -1)[:, 1:][:, np.argsort(measured.x)]
+    if model.kind == "frame":
+        from .frame_data import sensor_order
+
+        order = sensor_order(model, measured.sensors)
+    else:
+        order = np.argsort(measured.x)
+    shapes = r.reshape(measured.n_modes, -1)[:, 1:][:, order]
     if shapes.shape[1] < 3:
         return 0.0
     shapes = shapes - shapes.mean(axis=1, keepdims=True)
@@ -383,7 +389,8 @@ def _job(args):
     kind, payload = args
     before = SOLVER_TALLY.copy()
     result = {"profile": _fit_profile, "candidate": _fit_candidate,
-              "generic": _generic_update, "without": _fit_without}[kind](*payload)
+              "generic": _generic_only, "draw": _draw,
+              "without": _fit_without}[kind](*payload)
     return result, SOLVER_TALLY - before
 
 
@@ -398,6 +405,7 @@ def _run_jobs(jobs, progress, labels):
         if workers < 2:
             raise OSError("one core")
         context = multiprocessing.get_context("fork")
+        warm_solver()   # loaded once here, not once in every worker
         pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                    initializer=_single_threaded_blas)
         try:
@@ -422,6 +430,27 @@ def _run_jobs(jobs, progress, labels):
                 if progress:
                     progress(i + 1, len(jobs), labels[i])
     return results
+
+
+def warm_solver() -> None:
+    """Load IPOPT (CasADi's plugin, its linear solver) and LAPACK's eigen solver once in this
+    process, by a trivial solve of each: forked workers inherit them loaded (measured: the
+    first fit in a fresh worker took 0.1 s against 0.02 s for the same fit next)."""
+    global _WARM
+    if _WARM:
+        return
+    import casadi as ca
+    import scipy.linalg as sla
+
+    x = ca.MX.sym("x", 2)
+    solver = ca.nlpsol("warm", "ipopt", {"x": x, "f": ca.sumsqr(x - 1)},
+                       {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes"})
+    solver(x0=[0, 0], lbx=[-2, -2], ubx=[2, 2])
+    sla.eigh(np.diag([2.0, 1.0, 3.0]), np.eye(3), subset_by_index=[0, 1])
+    _WARM = True
+
+
+_WARM = False
 
 
 def stop_pool(pool) -> None:
@@ -544,12 +573,15 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     start = time.perf_counter()
     noise = noise_of(freq_noise, shape_noise)
     names = _candidates(model, candidates)
-    measured, dropped = on_model(measured, model)
+    frame = model.kind == "frame"
+    measured, dropped = (measured, []) if frame else on_model(measured, model)
     check_model_size(_discretise(model), measured, model.source or model.name)
-    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    C = None if frame else sensor_matrix(model.nodes, model.kind, measured.x, measured.dof,
+                                         measured.source)
     baseline = misfit(model, measured, noise, C)
-    places = compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
-    hint = places[0][0] / model.length if places else 0.5
+    places = failure_places(model, measured, noise)
+    # where along the beam the model fails, x / L (a frame's effects start on every member)
+    hint = 0.5 if frame or not places else places[0][0] / model.length
     reference = (fit_effects(model, measured, [], noise=noise, C=C)
                  if slots_for(model, []) and any(s.variables for s in slots_for(model, []))
                  else None)
@@ -584,11 +616,21 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         jobs.append(("without", (model, measured, noise, i)))
         labels.append(f"without {model.effects[i].name}")
     with_generic = realise and model.kind == "beam" and not measured.frequency_only
-    if with_generic:  # the paper's generic update runs beside the candidates
+    copies = []
+    if with_generic:  # the paper's generic update runs beside the candidates, and so do
+        # the updates of the noisy copies of the model's own modes that read it
+        from .realisation import noisy_copies
+
+        copies = noisy_copies(_discretise(model), measured, noise)
         jobs.append(("generic", (model, measured, noise)))
         labels.append("generic-element update")
+        jobs += [("draw", (model, c, noise)) for c in copies]
+        labels += [f"its noise band ({i + 1} of {len(copies)})" for i in range(len(copies))]
     fits = _run_jobs(jobs, progress, labels) if jobs else []
-    generic, band = fits.pop() if with_generic else (None, None)
+    draws = fits[len(fits) - len(copies):]
+    fits = fits[:len(fits) - len(copies)]
+    generic, band = _band(model, measured, noise, fits.pop(), draws) if with_generic \
+        else (None, None)
     without = fits[len(fits) - len(drops):]
     fits = fits[:len(fits) - len(drops)]
     for f in fits:
@@ -730,8 +772,13 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             nodal = realise_rows(generic.discretisation, _discretise(model))
         found = ranked[0] if ranked and ranked[0].significant else None
         if band is not None and found is not None:
+            from .realisation import noisy_copies
+
+            copies = noisy_copies(_discretise(found.model), measured, noise, seed=1)
+            draws = _run_jobs([("draw", (model, c, noise)) for c in copies], None,
+                              ["reading of the finding"] * len(copies))
             band = explain(band, _discretise(model), _discretise(found.model), measured,
-                           noise)
+                           noise, draws=draws)
         words = (describe_profile(band, found.name if found else None,
                                   found is not None and explains(found))
                  if band is not None else [])
@@ -795,8 +842,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     if verdict == "effect_found":
         finding = together if suggested and together is not None else ranked[0]
         if not explains(finding):
-            where = compare(finding.model, measured,
-                            noise=max(noise.shape, 1e-3)).failure_places()
+            where = failure_places(finding.model, measured, noise)
             remaining = {"chi2_per_residual": finding.misfit.chi2_per_residual,
                          "freq_error_rms_pct": finding.misfit.freq_error_rms_pct,
                          "where": [x for x, _ in where]}
@@ -866,7 +912,8 @@ def _swap(model, measured, noise, reference, names, sel):
         rest = [e for j, e in enumerate(reference.effects) if j != i]
         base = model.with_effects(rest, check=False)
         where = effect.parameters.get("position")
-        hint = where / model.length if isinstance(where, (int, float)) else 0.5
+        hint = where / model.length if isinstance(where, (int, float)) \
+            and model.kind != "frame" else 0.5
         alts = []
         for name in names:
             other = effect_type(name)
@@ -897,6 +944,16 @@ def _profile_argument(profile) -> str:
 def _skipped_note(skipped, measured, model) -> str:
     """One sentence for the candidates not tried."""
     return "not tried: " + "; ".join(f"{n} ({r})" for n, r in skipped)
+
+
+def failure_places(model, measured, noise) -> list:
+    """Where the model fails, largest first: (x, fraction) along a beam, (sensor, fraction)
+    on a frame (:meth:`~gfe_opt.frame_data.FrameComparison.failure_places`)."""
+    if model.kind == "frame":
+        from .frame_data import compare_frame
+
+        return compare_frame(model, measured).failure_places()
+    return compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
 
 
 def _discretise(model):
@@ -1027,6 +1084,34 @@ def _generic_update(model, measured, noise):
     return result, band
 
 
+def _generic_only(model, measured, noise):
+    """The paper's generic-element update of the measured data (None if it fails)."""
+    from .updating import update_generic
+
+    try:
+        return update_generic(_discretise(model), measured, noise=max(noise.shape, 1e-3))
+    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+        return None
+
+
+def _draw(model, data, noise):
+    """One update of a noisy copy (:func:`~gfe_opt.realisation.generic_ratio`)."""
+    from .realisation import generic_ratio
+
+    return generic_ratio(_discretise(model), data, noise)
+
+
+def _band(model, measured, noise, result, draws):
+    """(result, its profile band from the draws run beside it) as :func:`_generic_update`
+    gives them."""
+    from .realisation import profile_band
+
+    if result is None:
+        return None, None
+    return result, (profile_band(_discretise(model), measured, result, noise, draws=draws)
+                    if result.ok else None)
+
+
 def _alike(ranked, sel) -> list:
     """Significant fits other than the best that fit the data as well as it (χ² within
     :data:`ALIKE_CHI2` noise-floor units): the data cannot tell them apart."""
@@ -1070,7 +1155,7 @@ def _undetermined(fit, model) -> list:
     """The effect sets that fit as well as ``fit`` and are not its mirror image on a
     symmetric model (which symmetry explains): each is a reason the data do not determine
     the finding."""
-    symmetric = model.supports[0] == model.supports[1] and not any(
+    symmetric = model.kind != "frame" and model.supports[0] == model.supports[1] and not any(
         effect_type(e.name).local for e in model.effects)
     out = []
     for effects in fit.equivalent:
@@ -1131,7 +1216,7 @@ def equivalent_notes(fit, measured) -> list[str]:
 def _mirror(fit, measured, noise, C, sel) -> str | None:
     """A sentence when the added local effect fits as well at its mirror image (x -> L - x):
     on a symmetric beam frequencies cannot tell the two apart."""
-    if fit.added is None:
+    if fit.added is None or fit.model.kind == "frame":
         return None
     model = fit.model
     added = fit.effects[fit.added]

@@ -329,6 +329,24 @@ def compare_frame(model: FrameModel, measured: FrameMeasured,
                            scale=None if residual is None else np.array(scale))
 
 
+def sensor_order(model: FrameModel, sensors) -> np.ndarray:
+    """The sensors in order along the structure: member by member (file order), from each
+    member's start; a sensor at a node counts at the first member that starts or ends
+    there.  Neighbours in this order are neighbours on a member (the whiteness of the
+    shape residuals, as along a beam)."""
+    keys = []
+    for s in sensors:
+        if "node" in s:
+            i, m = next((i, m) for i, m in enumerate(model.members)
+                        if s["node"] in (m.start, m.end))
+            at = 0.0 if s["node"] == m.start else model.member_length(m)
+        else:
+            i = next(i for i, m in enumerate(model.members) if m.id == s["member"])
+            at = s["position"]
+        keys.append((i, at))
+    return np.array(sorted(range(len(keys)), key=lambda k: keys[k]), dtype=int)
+
+
 def sensor_places(model: FrameModel, sensors) -> tuple[np.ndarray, np.ndarray]:
     """Each sensor's point (x, y) and unit direction, in the frame's axes."""
     points, directions = [], []

@@ -347,7 +347,7 @@ def own_modes(disc: Discretisation, measured):
 
 
 def profile_band(disc: Discretisation, measured, result, noise, samples: int = BAND_SAMPLES,
-                 seed: int = 0) -> ProfileBand:
+                 seed: int = 0, draws=None) -> ProfileBand:
     """The generic update's nodal k_i / k_i0 read against two references:
 
     * its **null profile**, the mean of the same update on ``samples`` copies of the model's
@@ -356,34 +356,55 @@ def profile_band(disc: Discretisation, measured, result, noise, samples: int = B
       even on data the model fits, and that is not a finding;
     * its **noise band**, the spread of those copies (fixed seed: reproducible): what the
       update shows when the model is right.  (Adding noise to the measured data instead
-      doubles the noise, and the expansion, tuned to the stated level, swings by tens of %.)"""
+      doubles the noise, and the expansion, tuned to the stated level, swings by tens of %.)
+
+    ``draws``: the updates (:func:`generic_ratio`) of :func:`noisy_copies` ``(disc,
+    measured, noise, samples, seed)`` already run (in parallel, by the diagnosis); None
+    runs them here."""
     n = disc.n_elements
     own = own_modes(disc, measured)
-    null, sigma = _reading(disc, disc, own, noise, samples, seed)
+    if draws is None:
+        draws = [generic_ratio(disc, c, noise) for c in _copies(own, noise, samples, seed)]
+    null, sigma = draws_summary(draws, n)
     ratio = result.q[:n + 1] / result.q0[:n + 1] / null
     sigma = np.where(_determined(disc, own), sigma, np.inf)
     trend, features = _features(disc.nodes, ratio, sigma, measured.n_modes)
     return ProfileBand(disc.nodes, ratio, sigma, trend, tuple(features), null)
 
 
-def _reading(disc, truth, own, noise, samples, seed):
-    """The generic update of ``samples`` noisy copies of ``truth``'s own modes (noise of the
-    stated level; fixed seed): their mean and spread as k_i / k_i0 of ``disc``.  Noisy,
-    because the expansion treats noise-free data differently (its discrepancy principle
-    smooths them by the stated noise): the measured data are read the same way."""
+def noisy_copies(truth: Discretisation, measured, noise, samples: int = BAND_SAMPLES,
+                 seed: int = 0) -> list:
+    """``samples`` copies of ``truth``'s own modes at the sensors of ``measured`` with noise
+    of the stated level (fixed seed: reproducible), as measured data: what
+    :func:`profile_band` (``truth`` the model, seed 0) and :func:`explain` (``truth`` the
+    fitted model, seed 1) read with the generic update.  Noisy, because the expansion
+    treats noise-free data differently (its discrepancy principle smooths them by the
+    stated noise): the measured data are read the same way."""
+    return _copies(own_modes(truth, measured), noise, samples, seed)
+
+
+def _copies(own, noise, samples, seed) -> list:
     from .measured import make_measured
 
-    n = disc.n_elements
     rng = np.random.default_rng(seed)
-    draws = []
+    out = []
     for _ in range(samples):
         y = own.shapes + noise.shape * np.max(np.abs(own.shapes), axis=0) \
             * rng.standard_normal(own.shapes.shape)
         f = own.frequencies_hz * (1 + noise.freq * rng.standard_normal(own.n_modes))
-        draw = _generic_ratio_of(disc, make_measured(own.x, own.dof, f, y, own.source),
-                                 noise, n)
-        if draw is not None:
-            draws.append(draw)
+        out.append(make_measured(own.x, own.dof, f, y, own.source))
+    return out
+
+
+def generic_ratio(disc: Discretisation, data, noise):
+    """One draw: the generic update of ``data`` on ``disc`` as k_i / k_i0 (None if it
+    fails)."""
+    return _generic_ratio_of(disc, data, noise, disc.n_elements)
+
+
+def draws_summary(draws, n: int):
+    """The mean and spread of the draws (k_i / k_i0; failed draws left out)."""
+    draws = [d for d in draws if d is not None]
     if len(draws) < 3:
         return np.ones(n + 1), np.full(n + 1, np.inf)
     centre = np.mean(draws, axis=0)
@@ -395,13 +416,18 @@ def _reading(disc, truth, own, noise, samples, seed):
 
 
 def explain(band: ProfileBand, disc: Discretisation, fitted: Discretisation, measured,
-            noise, samples: int = BAND_SAMPLES, seed: int = 1) -> ProfileBand:
+            noise, samples: int = BAND_SAMPLES, seed: int = 1, draws=None) -> ProfileBand:
     """What the generic update would show if ``fitted`` (the model with the effect found)
     were the truth: its own modes, read like the data against the same null profile and
-    band.  A feature of the data is explained when that reading shows it too."""
+    band.  A feature of the data is explained when that reading shows it too.  ``draws``:
+    the updates on ``disc`` of :func:`noisy_copies` ``(fitted, measured, noise, samples,
+    seed)`` already run; None runs them here."""
     from dataclasses import replace
 
-    reading, _ = _reading(disc, fitted, own_modes(fitted, measured), noise, samples, seed)
+    if draws is None:
+        draws = [generic_ratio(disc, c, noise)
+                 for c in noisy_copies(fitted, measured, noise, samples, seed)]
+    reading, _ = draws_summary(draws, disc.n_elements)
     explained = reading / band.null
     rest = [f for f in band.features if not _shows(f, band.x, explained,
                                                    np.isfinite(band.sigma))]
