@@ -302,8 +302,8 @@ def slots_for(model: Model, adding) -> list[Slot]:
     out = []
     for e, added in entries:
         kind = effect_type(e.name)
-        fixed = {k: e.parameters[k] for k in kind.fixed_keys() if k in e.parameters}
-        missing = [k for k in kind.fixed_keys() if k not in fixed]
+        fixed = {k: e.parameters[k] for k in kind.fixed_keys(model) if k in e.parameters}
+        missing = [k for k in kind.fixed_keys(model) if k not in fixed]
         if missing:
             raise GfeInputError(None, e.name, f"needs {', '.join(missing)} to be fitted")
         held = any(n in names for n in kind.redundant_with)

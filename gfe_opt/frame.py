@@ -40,7 +40,8 @@ from . import elements as el
 from .errors import GfeInputError
 
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
-FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation")
+FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
+                 "point_mass", "axial_stiffness")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -291,6 +292,15 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
     if member_id not in {m.id for m in model.members}:
         raise GfeInputError(where, prefix + "member", f"no member {member_id!r}")
     member = model.member(member_id)
+    if name == "point_mass":
+        return _point_mass(model, member, raw, where, prefix)
+    if name == "axial_stiffness":
+        no_unknown(raw, {"effect", "member", "ratio"}, where, prefix)
+        ratio = _number(raw, "ratio", where, positive=True, prefix=prefix)
+        if ratio > 10.0:
+            raise GfeInputError(where, prefix + "ratio", f"must lie in (0, 10] (EA of the "
+                                f"member over the modelled), got {ratio:g}")
+        return _as_effect({"effect": name, "member": member_id, "ratio": ratio})
     if name == "crack":
         no_unknown(raw, {"effect", "member", "position", "depth_ratio"}, where, prefix)
         length = model.member_length(member)
@@ -314,6 +324,28 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
                             f"node {node!r} (its ends: {member.start}, {member.end})")
     k = _number(raw, "stiffness", where, positive=True, prefix=prefix)
     return _as_effect({"effect": name, "member": member_id, "node": node, "stiffness": k})
+
+
+def _point_mass(model: FrameModel, member: Member, raw: dict, where: str, prefix: str):
+    """A mass on a member at ``position`` (m from its start; an end is the joint there),
+    held by neither support translation of its place."""
+    from .effects.base import no_unknown
+    from .model import _number
+
+    no_unknown(raw, {"effect", "member", "position", "mass"}, where, prefix)
+    length = model.member_length(member)
+    x = _number(raw, "position", where, prefix=prefix)
+    if not 0.0 <= x <= length:
+        raise GfeInputError(where, prefix + "position", f"must lie on the member [0, "
+                            f"{length:g}] m, got {x:g}")
+    mass = _number(raw, "mass", where, positive=True, prefix=prefix)
+    end = member.start if x == 0.0 else member.end if x == length else None
+    support = dict(model.supports).get(end)
+    if {0, 1} <= set(SUPPORT_TYPES.get(support, ())):
+        raise GfeInputError(where, prefix + "position", f"node {end!r} is a {support} support "
+                            "that holds the structure still: a mass there does nothing")
+    return _as_effect({"effect": "point_mass", "member": member.id, "position": x,
+                       "mass": mass})
 
 
 def _support_effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
@@ -368,9 +400,13 @@ def check_repeats(effects, where) -> None:
 def _effect_key(effect) -> tuple | None:
     """What two instances of a frame effect may not share (a crack may repeat)."""
     e = {"effect": effect.name, **effect.parameters}
+    if "node" not in e:
+        return None   # --add without a place: every place is tried
     if e["effect"] == "joint_spring":
         return ("joint_spring", e["member"], e["node"])
-    if e["effect"] == "crack":
+    if e["effect"] == "axial_stiffness":
+        return ("axial_stiffness", e["member"])
+    if e["effect"] in ("crack", "point_mass"):
         return None
     return (e["effect"], e["node"], e.get("direction"))
 
@@ -513,12 +549,21 @@ def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
     return out
 
 
+def axial_rigidity(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
+    """EA of each element [N], times the ``ratio`` of an ``axial_stiffness`` effect on its
+    member (a loose brace)."""
+    ratio = {e["member"]: e["ratio"] for e in model.raw_effects
+             if e["effect"] == "axial_stiffness"}
+    return np.array([model.members[k].E * model.members[k].area
+                     * ratio.get(model.members[k].id, 1.0) for k in mesh.element_member])
+
+
 def element_matrices(model: FrameModel, mesh: FrameMesh):
     """(K_e, M_e), each (n_el, 6, 6) in global axes: bar ⊕ beam in the member's axes,
     rotated by T = diag(R, R)."""
     n = mesh.element_length.size
     L = mesh.element_length
-    EA = np.array([model.members[k].E * model.members[k].area for k in mesh.element_member])
+    EA = axial_rigidity(model, mesh)
     rhoA = np.array([model.members[k].rho * model.members[k].area
                      for k in mesh.element_member])
     local_k = np.zeros((n, 6, 6))
@@ -567,6 +612,17 @@ def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
     if mesh.grounded:
         dof, k = zip(*mesh.grounded)
         K = K + sp.csr_matrix((k, (dof, dof)), shape=shape)
+    masses = [e for e in model.raw_effects if e["effect"] == "point_mass"]
+    if masses:
+        from .frame_data import observation
+
+        # m (cx cxᵀ + cy cyᵀ): the mass moves with the member's x and y displacement at its
+        # place (the element's shape functions there, as a sensor reads them)
+        places = [{"member": e["member"], "position": e["position"], "direction": d}
+                  for e in masses for d in ("x", "y")]
+        C = observation(model, mesh, places)
+        m = np.repeat([e["mass"] for e in masses], 2)
+        M = M + (C.T @ sp.diags(m) @ C).tocsr()
     return K, M
 
 
@@ -665,7 +721,7 @@ def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:
     d1 = v1 - v2 + L * u[:, 5]                            # d = H [w1, Lθ1, w2, Lθ2]
     d2 = L * (u[:, 2] - u[:, 5])
     p = bending_parameters(model, mesh)
-    EA = np.array([model.members[k].E * model.members[k].area for k in mesh.element_member])
+    EA = axial_rigidity(model, mesh)
     energy = (EA[:, None] / L) * axial**2 + (p[:, 0, None] * d1**2 + 2 * p[:, 1, None] * d1 * d2
                                              + p[:, 2, None] * d2**2) / L**3
     total = energy.sum(axis=0)

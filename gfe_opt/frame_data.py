@@ -49,6 +49,12 @@ class FrameMeasured(ModeCounts):
     def n_sensors(self) -> int:
         return 0 if self.shapes is None else len(self.sensors)
 
+    @property
+    def n_neighbour_pairs(self) -> int:
+        """Pairs of neighbours in the whiteness test of the shape residuals: sensors of one
+        direction are a chain along the structure (:func:`neighbour_pairs`)."""
+        return max(self.n_sensors - len({str(s["direction"]) for s in self.sensors}), 0)
+
 
 def load_frame_measured(path, model: FrameModel) -> FrameMeasured:
     """Read frame measured modes (JSON, module docstring), each sensor checked against
@@ -345,6 +351,20 @@ def sensor_order(model: FrameModel, sensors) -> np.ndarray:
             at = s["position"]
         keys.append((i, at))
     return np.array(sorted(range(len(keys)), key=lambda k: keys[k]), dtype=int)
+
+
+def neighbour_pairs(model: FrameModel, sensors) -> tuple[np.ndarray, np.ndarray]:
+    """Neighbouring sensors for the whiteness test: the sensors of each direction in order
+    along the structure (:func:`sensor_order`), each with the next of the same direction.
+    An x and a y reading at one point are two components, not neighbours: model error
+    correlates a component along the structure, not one component with the other."""
+    order = sensor_order(model, sensors)
+    a, b = [], []
+    for d in dict.fromkeys(str(s["direction"]) for s in sensors):
+        chain = [i for i in order if str(sensors[i]["direction"]) == d]
+        a += chain[:-1]
+        b += chain[1:]
+    return np.array(a, dtype=int), np.array(b, dtype=int)
 
 
 def sensor_places(model: FrameModel, sensors) -> tuple[np.ndarray, np.ndarray]:

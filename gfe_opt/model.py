@@ -168,9 +168,9 @@ def load_model(path, *, frames: bool = False) -> Model:
     if isinstance(data, dict) and data.get("kind") == "frame":
         if not frames:
             raise GfeInputError(where, "kind", "a plane frame: gfe-opt computes its modes, "
-                                "compares them with a test and updates it so far (gfe-opt "
-                                "modes, compare, update --add joint_spring:node=...,member=...)"
-                                "; diagnose, batch and demo take beams and bars")
+                                "compares them with a test, diagnoses and updates it so far "
+                                "(gfe-opt modes, compare, diagnose, update); batch and demo "
+                                "take beams and bars")
         from .frame import frame_from_dict
 
         return frame_from_dict(data, where)

@@ -153,13 +153,13 @@ def format_diagnosis(result, model) -> str:
                          f"{_ratio(pair.misfit.chi2_per_residual)}")
         remaining = getattr(result, "remaining", None)
         if remaining is not None:
-            where = (" where: " + ", ".join(f"x = {x:.3f} m" for x in remaining["where"])
+            where = (" where: " + ", ".join(_place(x) for x in remaining["where"])
                      if remaining["where"] else "")
             lines.append(f"  a difference remains after it: χ²/n "
                          f"{_ratio(remaining['chi2_per_residual'])}, frequency error "
                          f"{remaining['freq_error_rms_pct']:.3f} %{where} — diagnose again "
                          "after adding it")
-        adds = " ".join(f"--add {name}" for name in result.suggested)
+        adds = " ".join(f"--add {a}" for a in add_arguments(result, model))
         them = "it" if len(result.suggested) == 1 else "them"
         swap = getattr(result, "replace", None)
         if swap is not None:
@@ -168,7 +168,7 @@ def format_diagnosis(result, model) -> str:
         else:
             lines.append(f"  add {them}: gfe-opt update MODEL MEASURED {adds}")
     elif result.verdict == "unexplained":
-        where = ("where the model fails: " + ", ".join(f"x = {x:.3f} m" for x, _ in
+        where = ("where the model fails: " + ", ".join(_place(x) for x, _ in
                                                        result.localisation)
                  if result.localisation else "where it fails is unknown without mode shapes")
         lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 fits to the noise); {where}")
@@ -181,6 +181,32 @@ def format_diagnosis(result, model) -> str:
     lines += [f"note: {n}" for n in result.notes]
     lines.append(f"({result.seconds:.1f} s)")
     return "\n".join(lines)
+
+
+def add_arguments(result, model) -> list[str]:
+    """The ``update --add`` arguments of a diagnosis's suggestion: the effect names (a beam's
+    update fits each from its grid), on a frame with the place found (``joint_spring:
+    node=C,member=beam``): the place is a choice, not fitted, and naming it spares update
+    the search over every place."""
+    if model.kind != "frame" or not result.suggested:
+        return list(result.suggested)
+    fit = result.together if result.together is not None else result.best
+    found = fit.effects[len(fit.effects) - len(result.suggested):]
+    out = []
+    for e in found:
+        place = [p.name for p in effect_type(e.name).frame_parameters]
+        out.append(e.name + ":" + ",".join(f"{k}={e.parameters[k]}" for k in place)
+                   if place else e.name)
+    return out
+
+
+def _place(where) -> str:
+    """A place where a model fails: ``x = 0.190 m`` on a beam, a sensor on a frame."""
+    if isinstance(where, dict):
+        from .frame_data import sensor_label
+
+        return sensor_label(where)
+    return f"x = {where:.3f} m"
 
 
 def format_update(outcome) -> str:

@@ -55,11 +55,13 @@ class ExactFrame:
     """A frame of uniform members: ``nodes`` {id: (x, y)}, ``members`` [(from, to, E, rho,
     A, I)], ``supports`` {id: type}, ``joint_springs`` [(node, member index, k)],
     ``member_ids`` the members' names (for sensors on them), ``ground_springs`` [(node, DOF
-    0/1/2 for u/v/θ, k)]: a support's fixity of that DOF replaced by a spring to ground."""
+    0/1/2 for u/v/θ, k)]: a support's fixity of that DOF replaced by a spring to ground;
+    ``masses`` [(node, kg)]: a rigid mass at a node (it moves in x and y)."""
 
     def __init__(self, nodes, members, supports, joint_springs=(), member_ids=None,
-                 ground_springs=()):
+                 ground_springs=(), masses=()):
         self.ids = list(nodes)
+        self.masses = [(3 * self.ids.index(node) + d, m) for node, m in masses for d in (0, 1)]
         self.ground = [(3 * self.ids.index(node) + dof, k) for node, dof, k in ground_springs]
         self.member_ids = list(member_ids or range(len(members)))
         self.nodes = nodes
@@ -100,6 +102,8 @@ class ExactFrame:
             D[np.ix_([i, j], [i, j])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
         for i, k in self.ground:
             D[i, i] += k
+        for i, m in self.masses:
+            D[i, i] -= omega**2 * m
         return D[np.ix_(self.free, self.free)] / self.scale
 
     def frequency_near(self, estimate_hz, width=1e-3) -> float:

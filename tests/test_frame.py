@@ -159,8 +159,16 @@ def test_supports_that_give_against_the_exact_solution_and_their_limits():
     (lambda d: d["members"][1].update({"elements": 0}), "members[1].elements"),
     (lambda d: d.update({"effects": [{"effect": "joint_spring", "member": "beam",
                                       "node": "A", "stiffness": 10.0}]}), "effects[0].node"),
-    (lambda d: d.update({"effects": [{"effect": "point_mass", "member": "beam"}]}),
+    (lambda d: d.update({"effects": [{"effect": "shear", "member": "beam"}]}),
      "effects[0].effect"),
+    (lambda d: d.update({"effects": [{"effect": "point_mass", "member": "beam",
+                                      "mass": 0.1}]}), "effects[0].position"),
+    (lambda d: d.update({"effects": [{"effect": "point_mass", "member": "beam",
+                                      "position": 0.5, "mass": 0.1}]}), "effects[0].position"),
+    (lambda d: d.update({"effects": [{"effect": "point_mass", "member": "left-column",
+                                      "position": 0.0, "mass": 0.1}]}), "effects[0].position"),
+    (lambda d: d.update({"effects": [{"effect": "axial_stiffness", "member": "beam",
+                                      "ratio": 20.0}]}), "effects[0].ratio"),
     (lambda d: d.update({"effects": [{"effect": "support_spring", "node": "B",
                                       "stiffness": 1.0}]}), "effects[0].node"),
     (lambda d: (d["supports"][0].update({"type": "roller-x"}), d.update({"effects": [
@@ -181,7 +189,7 @@ def test_bad_frame_files_are_one_line_naming_the_key(change, key):
     assert key in str(info.value) and "\n" not in str(info.value)
 
 
-def test_cli_modes_writes_the_frame_contract_and_diagnose_says_what_frames_can_do(
+def test_cli_modes_writes_the_frame_contract_and_diagnose_reads_it(
         tmp_path):
     out = tmp_path / "portal-modes.json"
     model = problem_file("portal-frame.toml")
@@ -195,9 +203,15 @@ def test_cli_modes_writes_the_frame_contract_and_diagnose_says_what_frames_can_d
     assert all(len(m["shape"]) == len(doc["sensors"]) for m in doc["modes"])
     assert doc["modes"][0]["frequency"] == pytest.approx(74.479366, rel=3e-5)
     run = subprocess.run([sys.executable, "-m", "gfe_opt", "diagnose", str(model),
-                          str(out)], capture_output=True, text=True)
+                          str(out), "--json"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr   # its own modes: nothing is missing
+    assert json.loads(run.stdout)["verdict"] == "consistent"
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "diagnose", str(model),
+                          str(out), "--plot", str(tmp_path / "figs")],
+                         capture_output=True, text=True)
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert len(run.stderr.strip().splitlines()) == 1 and "frame" in run.stderr
+    assert not (tmp_path / "figs").exists()
     again = subprocess.run([sys.executable, "-m", "gfe_opt", "modes", str(model), "--out",
                             str(out)], capture_output=True, text=True)
     assert again.returncode == 2 and len(json.loads(out.read_text())["modes"]) == 4
@@ -488,9 +502,10 @@ def test_cli_update_on_a_frame(tmp_path):
                           "joint_spring:node=A,member=beam"], capture_output=True, text=True)
     assert bad.returncode == 2 and "does not end at node 'A'" in bad.stderr
     assert len(bad.stderr.strip().splitlines()) == 1
-    crack = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
-                            "crack"], capture_output=True, text=True)
-    assert crack.returncode == 2 and "not fitted on frames yet" in crack.stderr
+    shear = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
+                            "shear"], capture_output=True, text=True)
+    assert shear.returncode == 2 and "not fitted on frames yet" in shear.stderr
+    assert len(shear.stderr.strip().splitlines()) == 1
     twice = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data] + [
         "--add", "joint_spring:node=B,member=beam"] * 2, capture_output=True, text=True)
     assert twice.returncode == 2 and "repeats" in twice.stderr

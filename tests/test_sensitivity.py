@@ -46,8 +46,8 @@ def _instance(model, name):
     """The effect with its chosen parameters (a side, knots) from its own starts."""
     kind = effect_type(name)
     for start in kind.starts(model, 0.37):
-        fixed = {k: start[k] for k in kind.fixed_keys() if k in start}
-        if len(fixed) == len(kind.fixed_keys()):
+        fixed = {k: start[k] for k in kind.fixed_keys(model) if k in start}
+        if len(fixed) == len(kind.fixed_keys(model)):
             return Effect(name, fixed)
     return Effect(name, {})
 

@@ -71,6 +71,7 @@ def candidate_names(kind: str) -> tuple:
 def _register_builtins():
     from . import (
         axial_load,
+        axial_stiffness,
         crack,
         foundation,
         joint_spring,
@@ -87,7 +88,7 @@ def _register_builtins():
 
     for module in (material, crack, section_loss, shear, axial_load, foundation,
                    support_spring, support_translation, point_spring, point_mass,
-                   stiffness_profile, mass_profile, joint_spring):
+                   stiffness_profile, mass_profile, joint_spring, axial_stiffness):
         register_effect(module.EFFECT)
 
 

@@ -215,6 +215,18 @@ def no_unknown(tbl, known, where, prefix):
             raise GfeInputError(where, prefix + key, f"unknown key{hint}")
 
 
+def frame_member_at(model, node: str):
+    """The first member (file order) that starts or ends at ``node`` of a frame."""
+    return next(m for m in model.members if node in (m.start, m.end))
+
+
+def frame_member_scale(model, node: str, power: int) -> float:
+    """EI / L^power of the first member at ``node``: the order-one scale of a spring there
+    (power 1: rotation, N m/rad; 3: translation, N/m)."""
+    m = frame_member_at(model, node)
+    return m.E * m.inertia / model.member_length(m) ** power
+
+
 def nominal_rigidity(model) -> float:
     """EI (beam) or EA (bar) of the model file's section and E, without effects [N m², N]:
     the fixed scale of the order-one variables."""
@@ -246,14 +258,22 @@ class EffectType:
     uniform_reference: bool = False
     #: effects whose presence holds this one (E and a stiffness profile are one parameter)
     redundant_with: tuple = ()
+    #: on a plane frame (``"frame"`` in :attr:`kinds`): the parameters that place the effect
+    #: (a member, a node, a direction; chosen, not fitted), in place of a beam's ``side``
+    frame_parameters: tuple = ()
 
     # -- parameters -------------------------------------------------------------------
     @property
     def keys(self) -> tuple:
         return tuple(p.name for p in self.parameters)
 
+    @property
+    def all_parameters(self) -> tuple:
+        """The frame's place parameters, then the others (what :meth:`describe` prints)."""
+        return (*self.frame_parameters, *self.parameters)
+
     def parameter(self, key: str) -> Parameter:
-        return next(p for p in self.parameters if p.name == key)
+        return next(p for p in self.all_parameters if p.name == key)
 
     def validate(self, model, params: dict, where: str, prefix: str = "",
                  partial: bool = False) -> dict:
@@ -261,7 +281,10 @@ class EffectType:
         :class:`GfeInputError` naming the field and the allowed range."""
         if model.kind == "frame" and model.kind not in self.kinds:
             raise GfeInputError(where, f"{prefix}effect", f"effect {self.name!r} is not "
-                                "fitted on frames yet (a frame's update takes joint_spring)")
+                                "fitted on frames yet (a frame's update takes crack, "
+                                "joint_spring, support_spring and support_translation)")
+        if model.kind == "frame":
+            return self._validate_frame(model, params, where, prefix, partial)
         if model.kind not in self.kinds:
             raise GfeInputError(where, f"{prefix}effect", f"effect {self.name!r} needs kind = "
                                 f"{' or '.join(repr(k) for k in self.kinds)}")
@@ -276,6 +299,31 @@ class EffectType:
             out[p.name] = p.check(params[p.name], model, where, f"{prefix}{p.name}")
         self.check(model, out, where, prefix)
         return out
+
+    def _validate_frame(self, model, params, where, prefix, partial) -> dict:
+        """A frame's effect by the frame file's rules (:func:`gfe_opt.frame._effect`); with
+        ``partial`` (``--add``) only what is given, and with no place given every place is
+        tried (:meth:`starts`)."""
+        from ..frame import _effect
+
+        place = [p.name for p in self.frame_parameters]
+        missing = [k for k in place if k not in params]
+        if partial and len(missing) == len(place):
+            no_unknown(params, {p.name for p in self.all_parameters}, where, prefix)
+            return dict(params)
+        if missing:
+            raise GfeInputError(where, f"{prefix}{missing[0]}", f"missing (a {self.name} on a "
+                                f"frame needs {' and '.join(place)})")
+        full = {"effect": self.name, **params}
+        if partial:   # placeholders for the values to be fitted: the place is checked
+            for key, value in self.frame_placeholders(model, params).items():
+                full.setdefault(key, value)
+        checked = _effect(model, full, where, prefix).parameters
+        return {k: checked[k] for k in checked if k in params}
+
+    def frame_placeholders(self, model, params) -> dict:
+        """Values that let a partly given frame effect (``--add``) be checked for its place."""
+        return {"stiffness": 1.0}
 
     def check(self, model, params: dict, where: str, prefix: str) -> None:
         """Checks across parameters or against the model (override when needed)."""
@@ -295,9 +343,14 @@ class EffectType:
         """Order-one variables for the fitted parameters (``fixed`` holds the others)."""
         raise NotImplementedError
 
-    def fixed_keys(self) -> tuple:
-        """Parameters that are chosen, not fitted (e.g. a spring's side)."""
-        return tuple(p.name for p in self.parameters if p.rule in ("choice", "knots"))
+    def fixed_keys(self, model=None) -> tuple:
+        """Parameters that are chosen, not fitted (e.g. a spring's side; on a frame
+        ``model``, the place); without a model, every one of either."""
+        beam = tuple(p.name for p in self.parameters if p.rule in ("choice", "knots"))
+        frame = tuple(p.name for p in self.frame_parameters)
+        if model is None:
+            return beam + frame
+        return frame if model.kind == "frame" else beam
 
     def starts(self, model, hint: float) -> list[dict]:
         """Starting parameter sets to try besides the grid (``hint`` = where the model
@@ -313,7 +366,7 @@ class EffectType:
             else:
                 out.setdefault(v.key, [])
                 out[v.key].append(phys)
-        return {k: out[k] for k in self.keys if k in out}
+        return {k: out[k] for k in (p.name for p in self.all_parameters) if k in out}
 
     def tie(self, model, variables: list[Variable], z):
         """Directions in which the fitted variables ``z`` can still move without changing
@@ -359,7 +412,7 @@ class EffectType:
         """``position = 0.190 ± 0.001 m, depth_ratio = 0.50 ± 0.01``; a parameter on a bound
         of its range (``bounds``: "at least" / "at most") as ``stiffness ≥ 1e9 N/m``."""
         parts = []
-        for p in self.parameters:
+        for p in self.all_parameters:
             if p.name not in params:
                 continue
             if p.name in (bounds or {}):

@@ -25,6 +25,9 @@ class Crack(EffectType):
                "exact-flexibility elements integrated through the crack zone")
     signature = "a local drop of k, a few half-depths wide, and a rise of |k'| beside it"
     local = True
+    kinds = ("beam", "frame")
+    frame_parameters = (Parameter("member", "", "choice", "the member (a frame; position "
+                                  "from its start node)"),)
     parameters = (
         Parameter("position", "m", "position", "distance of the crack from the left end"),
         Parameter("depth_ratio", "-", "fraction", "a/d: depth of each cut over the "
@@ -53,11 +56,22 @@ class Crack(EffectType):
                              support=(x_c - CRACK_REACH * decay, x_c + CRACK_REACH * decay))
 
     def variables(self, model, fixed):
+        if model.kind == "frame":   # x / member length, inside the member
+            length = model.member_length(model.member(fixed["member"]))
+            place = Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
+                             scale=lambda m: length)
+            return [place, Variable("depth_ratio", 0.01, 0.9, (0.2, 0.45, 0.7))]
         return [position_variable(),
                 Variable("depth_ratio", 0.01, 0.9, (0.2, 0.45, 0.7))]
 
     def starts(self, model, hint):
+        if model.kind == "frame":   # every member whose section has a depth
+            return [{"member": m.id} for m in model.members if m.depth is not None]
         return [{}, {"position": hint * model.length, "depth_ratio": 0.45}]
+
+    def frame_placeholders(self, model, params):
+        return {"position": 0.5 * model.member_length(model.member(params["member"])),
+                "depth_ratio": 0.1}
 
     def figures(self, model, params, band):
         if band is None or model.depth is None:

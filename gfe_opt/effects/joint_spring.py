@@ -28,6 +28,8 @@ class JointSpring(EffectType):
                                 "= 'frame'")
         no_unknown(params, set(self.keys), where, prefix)
         missing = [k for k in ("node", "member") if k not in params]
+        if partial and len(missing) == 2:
+            return dict(params)   # --add joint_spring: every joint end is tried
         if missing:
             raise GfeInputError(where, f"{prefix}{missing[0]}", "missing (a joint spring "
                                 "needs node and member)")
@@ -39,7 +41,7 @@ class JointSpring(EffectType):
         checked = _effect(model, full, where, prefix).parameters
         return {k: checked[k] for k in self.keys if k in params}
 
-    def fixed_keys(self):
+    def fixed_keys(self, model=None):
         return ("node", "member")
 
     def variables(self, model, fixed):
@@ -50,13 +52,20 @@ class JointSpring(EffectType):
                          scale=lambda m: scale)]
 
     def starts(self, model, hint):
-        """Every member end at a joint where two or more members meet."""
+        """Every member end at a joint where two or more members meet; where exactly two
+        meet and no support holds the joint's rotation, the first member's end only: a
+        spring at either end is the same structure (two rotations joined by one spring)."""
+        from ..frame import SUPPORT_TYPES
+
         ends = {}
         for m in model.members:
             for node in (m.start, m.end):
                 ends.setdefault(node, []).append(m.id)
+        held = {node for node, kind in model.supports if 2 in SUPPORT_TYPES[kind]}
         return [{"node": node, "member": member} for node, members in ends.items()
-                if len(members) > 1 for member in members]
+                if len(members) > 1
+                for member in (members[:1] if len(members) == 2 and node not in held
+                               else members)]
 
     def position(self, params):
         return None

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from .base import (
     FIXED_TRANSLATION,
     EffectType,
@@ -16,8 +18,10 @@ class PointMass(EffectType):
     name = "point_mass"
     physics = "a mass attached at one point (a sensor, a fixture)"
     signature = "a local rise of the coefficient of ẅ (ü) at one node"
-    kinds = ("beam", "bar")
+    kinds = ("beam", "bar", "frame")
     local = True
+    frame_parameters = (Parameter("member", "", "choice", "the member (a frame; position "
+                                  "from its start node, an end is the joint)"),)
     parameters = (
         Parameter("position", "m", "position", "distance from the left end"),
         Parameter("mass", "kg", "positive", "attached mass", null=0.0),
@@ -31,19 +35,42 @@ class PointMass(EffectType):
         build.add_point_mass(params["position"], params["mass"])
 
     def variables(self, model, fixed):
+        if model.kind == "frame":
+            return _frame_variables(model, model.member(fixed["member"]))
         return [position_variable(model),
                 Variable("mass", 1e-4, 3.0, (0.05, 0.2, 0.5),
                          scale=lambda m: m.rho * m.area * m.length)]
 
     def starts(self, model, hint):
+        if model.kind == "frame":   # along every member, its free ends included
+            return [{"member": m.id} for m in model.members]
         return [{}, {"position": hint * model.length,
                      "mass": 0.2 * model.rho * model.area * model.length}]
+
+    def frame_placeholders(self, model, params):
+        return {"position": 0.5 * model.member_length(model.member(params["member"])),
+                "mass": 1.0}
 
     def mark(self, ax, model, params, sigma, y, bounds=None):
         x = params["position"]
         ax.plot([x], [y], marker="s", color="tab:purple", ms=8, zorder=5)
         ax.annotate(f"{1000 * params['mass']:.3g} g", (x, y), textcoords="offset points",
                     xytext=(0, 9), ha="center", fontsize=7, color="tab:purple")
+
+
+def _frame_variables(model, member):
+    """x / member length (the grid's 19 interior places and each end whose node no
+    support holds in both translations) and the mass in units of the member's own."""
+    from ..frame import SUPPORT_TYPES
+
+    length = model.member_length(member)
+    supports = dict(model.supports)
+    ends = tuple(float(t) for t, node in ((0, member.start), (1, member.end))
+                 if not {0, 1} <= set(SUPPORT_TYPES.get(supports.get(node), ())))
+    own = member.rho * member.area * length
+    return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)) + ends,
+                     scale=lambda m: length),
+            Variable("mass", 1e-4, 3.0, (0.05, 0.2, 0.5), scale=lambda m: own)]
 
 
 EFFECT = PointMass()

@@ -4,7 +4,7 @@ gives)."""
 from __future__ import annotations
 
 from ..errors import GfeInputError
-from .base import EffectType, Parameter, Variable, nominal_rigidity
+from .base import EffectType, Parameter, Variable, frame_member_scale, nominal_rigidity
 
 SIDES = ("left", "right", "both")
 #: supports whose rotation a spring can restrain or, for a clamp, replace
@@ -17,10 +17,12 @@ class SupportSpring(EffectType):
                "rotation, on a clamped end it replaces the fixity (clamp compliance)")
     signature = "only at the end nodes: the moment there is no longer zero (pinned) or the "\
         "slope no longer zero (clamped)"
+    kinds = ("beam", "frame")
     parameters = (
         Parameter("stiffness", "N m/rad", "positive", "rotational stiffness", null=0.0),
         Parameter("side", "", "choice", "which end", choices=SIDES),
     )
+    frame_parameters = (Parameter("node", "", "choice", "the supported node (a frame)"),)
 
     def check(self, model, params, where, prefix):
         side = params.get("side")
@@ -39,10 +41,19 @@ class SupportSpring(EffectType):
             build.add_end_spring(side, params["stiffness"])
 
     def variables(self, model, fixed):
+        if model.kind == "frame":   # in units of EI/L of the first member at the node
+            scale = frame_member_scale(model, fixed["node"], 1)
+            return [Variable("stiffness", -3.0, 6.0, (-1.0, 0.0, 1.0, 2.0), log=True,
+                             scale=lambda m: scale)]
         return [Variable("stiffness", -3.0, 6.0, (-1.0, 0.0, 1.0, 2.0), log=True,
                          scale=lambda m: nominal_rigidity(m) / m.length)]
 
     def starts(self, model, hint):
+        if model.kind == "frame":   # every support that holds its node's rotation
+            from ..frame import RELEASES, SUPPORT_TYPES
+
+            return [{"node": n} for n, kind in model.supports
+                    if RELEASES["support_spring"] in SUPPORT_TYPES[kind]]
         ok = [s for s, end in (("left", 0), ("right", 1))
               if model.supports[end] in SPRING_SUPPORTS]
         sides = ok + (["both"] if len(ok) == 2 else [])

@@ -10,6 +10,7 @@ from .base import (
     Parameter,
     Variable,
     effect_sides,
+    frame_member_scale,
     nominal_rigidity,
 )
 
@@ -27,7 +28,7 @@ class SupportTranslation(EffectType):
     physics = ("translational spring at a pinned, clamped or fixed end that replaces the "
                "fixity of the deflection (beam w, bar u): a support that gives")
     signature = "only at the end nodes: the deflection there is no longer zero"
-    kinds = ("beam", "bar")
+    kinds = ("beam", "bar", "frame")
     #: the support's translation is no longer held (sensors there read the structure)
     releases_translation = True
     parameters = (
@@ -35,6 +36,9 @@ class SupportTranslation(EffectType):
                   null="inf"),
         Parameter("side", "", "choice", "which end", choices=SIDES),
     )
+    frame_parameters = (Parameter("node", "", "choice", "the supported node (a frame)"),
+                        Parameter("direction", "", "choice", "x or y (a frame)",
+                                  choices=("x", "y")))
 
     def check(self, model, params, where, prefix):
         for side in effect_sides(params):
@@ -50,10 +54,19 @@ class SupportTranslation(EffectType):
             build.add_end_spring(side, params["stiffness"], translation=True)
 
     def variables(self, model, fixed):
+        if model.kind == "frame":   # in units of EI/L³ of the first member at the node
+            scale = frame_member_scale(model, fixed["node"], 3)
+            return [Variable("stiffness", -1.0, 8.0, (1.0, 2.0, 3.0, 4.0), log=True,
+                             scale=lambda m: scale)]
         return [Variable("stiffness", -1.0, 8.0, (1.0, 2.0, 3.0, 4.0), log=True,
                          scale=_scale)]
 
     def starts(self, model, hint):
+        if model.kind == "frame":   # every translation a support holds
+            from ..frame import RELEASES, SUPPORT_TYPES
+
+            return [{"node": n, "direction": d} for n, kind in model.supports
+                    for d in ("x", "y") if RELEASES[d] in SUPPORT_TYPES[kind]]
         ok = [s for s, end in (("left", 0), ("right", 1))
               if model.supports[end] in FIXED_TRANSLATION]
         return [{"side": s} for s in ok + (["both"] if len(ok) == 2 else [])]
