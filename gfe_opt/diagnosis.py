@@ -261,6 +261,21 @@ class Diagnosis:
         """The effect found (None unless the verdict is ``effect_found``)."""
         return self.fits[0] if self.fits and self.fits[0].significant else None
 
+    def add_arguments(self) -> list[str]:
+        """The ``update --add`` arguments of the suggestion: the effect names (a beam's
+        update fits each from its grid); on a frame with the place found
+        (``joint_spring:node=C,member=beam``): a place is chosen, not fitted, and naming it
+        spares ``update`` the search over every place."""
+        fit = self.together if self.together is not None else self.best
+        if not self.suggested or fit is None or fit.model.kind != "frame":
+            return list(self.suggested)
+        out = []
+        for e in fit.effects[len(fit.effects) - len(self.suggested):]:
+            place = effect_type(e.name).fixed_keys(fit.model)
+            out.append(e.name + ":" + ",".join(f"{k}={e.parameters[k]}" for k in place)
+                       if place else e.name)
+        return out
+
     @property
     def current(self) -> Misfit:
         """The misfit of the model as it stands (present effects re-estimated)."""
@@ -278,6 +293,7 @@ class Diagnosis:
                 "skipped": [{"effect": name, "reason": reason} for name, reason in self.skipped],
                 "indistinguishable": [f.name for f in self.alike],
                 "suggested": list(self.suggested),
+                "add": self.add_arguments(),
                 "together": None if self.together is None else {
                     "effects": [self.together.effect_json(i)
                                 for i in range(len(self.together.effects))],

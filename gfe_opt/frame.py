@@ -626,6 +626,13 @@ def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
     return K, M
 
 
+#: free DOFs up to which a frame's modes come from the dense solve: a speed choice, not a
+#: result (measured side by side, ``python scripts/bench.py --parts frames``: dense is
+#: faster on the portal's 180 free DOFs, the sparse solve 2-4x faster on the
+#: three-storey frame's 351)
+DENSE_SOLVE_DOFS = 250
+
+
 class FrameDiscretisation:
     """A frame's mesh and matrices behind the interface the modal solve and the fits use
     (:class:`~gfe_opt.assembly.Discretisation`'s: ``kind``, ``free``, ``constrained``,
@@ -635,6 +642,11 @@ class FrameDiscretisation:
 
     kind = "frame"
     shear_g = None
+    #: the eigenvalue derivatives by Nelson's sparse form: a frame's DOFs are numbered
+    #: joints first, so its matrices are sparse but not banded, and the dense bordered
+    #: solve of :mod:`gfe_opt.sensitivity` cost 6x (portal, 183 DOFs) to 38x (three-storey,
+    #: 357) more (``python scripts/bench.py --parts frames``); the same derivatives to 1e-10
+    dense_derivatives = False
 
     def __init__(self, model: FrameModel):
         self.model = model
@@ -643,6 +655,10 @@ class FrameDiscretisation:
         self.n_dof = self.mesh.n_dof
         self.constrained = self.mesh.constrained
         self.free = np.setdiff1d(np.arange(self.n_dof), self.constrained)
+        #: LAPACK's dense solve up to :data:`DENSE_SOLVE_DOFS` free DOFs, shift-invert
+        #: Lanczos on the sparse pencil above (the modes agree to 1e-9, the Rayleigh
+        #: quotients to rounding)
+        self.dense_solve = self.free.size <= DENSE_SOLVE_DOFS
         #: EI/(ρA L⁴) of the most flexible member: the eigenvalue scale of the frame
         self.eigenvalue_scale = min(m.E * m.inertia / (m.rho * m.area
                                                        * model.member_length(m) ** 4)

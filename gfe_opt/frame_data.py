@@ -203,8 +203,28 @@ def _angle(direction, where, key) -> float:
                         f"{direction!r}")
 
 
+#: observation matrices kept (a fit evaluates one model after another on one mesh)
+_OBSERVATIONS: dict = {}
+OBSERVATIONS_KEPT = 16
+
+
 def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
-    """(n_sensors, n_dof): each sensor's reading of a displacement vector."""
+    """(n_sensors, n_dof): each sensor's reading of a displacement vector; built once a
+    mesh (its nodes, elements and DOFs: a joint spring gives a member end its own rotation)
+    and set of sensors, a copy returned."""
+    key = (repr(sensors), mesh.n_dof, mesh.element_dofs.tobytes(), mesh.xy.tobytes(),
+           tuple((m.id, m.elements) for m in model.members))
+    C = _OBSERVATIONS.get(key)
+    if C is None:
+        C = _observation(model, mesh, sensors)
+        while _OBSERVATIONS and len(_OBSERVATIONS) >= OBSERVATIONS_KEPT:
+            _OBSERVATIONS.pop(next(iter(_OBSERVATIONS)))
+        if OBSERVATIONS_KEPT > 0:
+            _OBSERVATIONS[key] = C
+    return C.copy()
+
+
+def _observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
     rows, cols, vals = [], [], []
     member_index = {m.id: k for k, m in enumerate(model.members)}
     for i, s in enumerate(sensors):

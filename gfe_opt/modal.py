@@ -75,20 +75,22 @@ class Modes:
 
 
 def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | None = None,
-                roundoff_fraction: float = 1e-8):
+                roundoff_fraction: float = 1e-8, dense: bool | None = None):
     """Lowest ``n_modes`` eigenpairs of the sparse pencil (K, M) with DOFs ``constrained`` fixed.
 
     Returns :class:`Modes` with shapes expanded to all DOFs (zeros at constrained ones),
     mass-normalised, sign fixed so that the largest-magnitude entry is positive (the first of
     equal ones, :func:`peak_rows`).  Eigenvalues
     smaller in magnitude than ``roundoff_fraction`` of the largest one computed are rigid-body
-    roundoff (zero); other negative ones are an error.
+    roundoff (zero); other negative ones are an error.  ``dense``: LAPACK on the dense
+    pencil or shift-invert Lanczos on the sparse one (None: dense up to
+    :data:`DENSE_LIMIT` free DOFs).
     """
     n = K.shape[0]
     free = np.setdiff1d(np.arange(n), np.asarray(constrained, dtype=int))
     if n_modes < 1 or n_modes > len(free) - 1:
         raise ValueError(f"n_modes must lie in [1, {len(free) - 1}], got {n_modes}")
-    dense = len(free) <= DENSE_LIMIT
+    dense = len(free) <= DENSE_LIMIT if dense is None else dense
     if dense:  # small models: numpy throughout (sparse slicing costs more than the solve)
         Kf = (K.toarray() if sp.issparse(K) else np.asarray(K))[np.ix_(free, free)]
         Mf = (M.toarray() if sp.issparse(M) else np.asarray(M))[np.ix_(free, free)]
@@ -167,7 +169,8 @@ def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
     if condensed(disc):
         return _condensed_modes(disc, n_modes, params)
     K, M = disc.global_matrices(params) if matrices is None else matrices
-    modes = solve_modes(K, M, n_modes, disc.constrained, disc.eigenvalue_scale)
+    modes = solve_modes(K, M, n_modes, disc.constrained, disc.eigenvalue_scale,
+                        dense=getattr(disc, "dense_solve", None))
     lam = _rayleigh(disc, modes.shapes, params, M)
     worst = _residual(K, M, modes.shapes, lam, disc.free)
     if worst > RESIDUAL_TOLERANCE:

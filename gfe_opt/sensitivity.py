@@ -42,15 +42,16 @@ class RepeatedEigenvalue(ValueError):
     """A mode's eigenvalue is (numerically) repeated: its shape is not differentiable."""
 
 
-def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None):
+def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None):
     """Derivatives of the eigenpairs (λ_j, φ_j) (columns of ``phi``, all DOFs, zero at the
     constrained ones, mass-normalised) with respect to p parameters.
 
     ``dK``, ``dM``: lists of p sparse (or dense) matrices over all DOFs; ``free``: the free
     DOFs; ``all_lam``: every computed eigenvalue (to refuse repeated ones).  Returns
-    ``(dlam, dphi)`` of shapes (m, p) and (n_dof, m, p)."""
+    ``(dlam, dphi)`` of shapes (m, p) and (n_dof, m, p).  ``dense``: LAPACK on the
+    bordered system or Nelson's sparse form (None: dense up to :data:`DENSE_DOFS`)."""
     free = np.asarray(free, dtype=int)
-    dense = free.size <= DENSE_DOFS
+    dense = free.size <= DENSE_DOFS if dense is None else dense
     K, M = _as(K, dense), _as(M, dense)
     lam = np.asarray(lam, dtype=float)
     phi = np.asarray(phi, dtype=float)

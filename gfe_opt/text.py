@@ -142,8 +142,8 @@ def format_diagnosis(result, model) -> str:
         pair = result.together
         if pair is not None:
             held = len(model.effects)
-            lines.append("  together, fitted with each other (what update --add gives; the "
-                         "figures show these):")
+            lines.append("  together, fitted with each other (what update --add gives" +
+                         ("):" if model.kind == "frame" else "; the figures show these):"))
             lines += [f"    {e.name}: "
                       f"{effect_type(e.name).describe(e.parameters, s, pair.bound_of(i))}"
                       for i, (e, s) in enumerate(zip(pair.effects, pair.sigma)) if i >= held]
@@ -159,7 +159,7 @@ def format_diagnosis(result, model) -> str:
                          f"{_ratio(remaining['chi2_per_residual'])}, frequency error "
                          f"{remaining['freq_error_rms_pct']:.3f} %{where} — diagnose again "
                          "after adding it")
-        adds = " ".join(f"--add {a}" for a in add_arguments(result, model))
+        adds = " ".join(f"--add {a}" for a in result.add_arguments())
         them = "it" if len(result.suggested) == 1 else "them"
         swap = getattr(result, "replace", None)
         if swap is not None:
@@ -181,23 +181,6 @@ def format_diagnosis(result, model) -> str:
     lines += [f"note: {n}" for n in result.notes]
     lines.append(f"({result.seconds:.1f} s)")
     return "\n".join(lines)
-
-
-def add_arguments(result, model) -> list[str]:
-    """The ``update --add`` arguments of a diagnosis's suggestion: the effect names (a beam's
-    update fits each from its grid), on a frame with the place found (``joint_spring:
-    node=C,member=beam``): the place is a choice, not fitted, and naming it spares update
-    the search over every place."""
-    if model.kind != "frame" or not result.suggested:
-        return list(result.suggested)
-    fit = result.together if result.together is not None else result.best
-    found = fit.effects[len(fit.effects) - len(result.suggested):]
-    out = []
-    for e in found:
-        place = [p.name for p in effect_type(e.name).frame_parameters]
-        out.append(e.name + ":" + ",".join(f"{k}={e.parameters[k]}" for k in place)
-                   if place else e.name)
-    return out
 
 
 def _place(where) -> str:

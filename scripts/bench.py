@@ -39,7 +39,16 @@ the regularisation holds it at its initial value).
    diagnoses, every batch row) is compared: largest relative difference of the parameters
    and of χ² (targets 1e-6 and 1e-9).
 
-``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale, fits.
+8. Frames (issue 24), ``--parts frames``: ``diagnose`` (noise stated) on the shipped
+   semi-rigid portal (60 elements) and on the three-storey frame (120 elements, 6 modes,
+   36 sensors: x and y at two points a member) with a 0.3 kg floor mass, its data from the
+   package's frame on a 3x finer mesh with 0.3 % / 0.05 % noise; each in a fresh process
+   with the frame's old solves (dense eigen-solve and dense bordered derivatives, the
+   observation matrix rebuilt every evaluation) and the new ones (sparse above
+   ``frame.DENSE_SOLVE_DOFS``, Nelson's sparse derivatives, the observation kept a mesh):
+   wall time, verdicts and the largest relative difference of every fitted parameter.
+
+``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale, fits, frames.
 """
 
 import argparse
@@ -111,12 +120,17 @@ def _in_process(n, weighting="rows"):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-elements", type=int, default=10000)
-    parser.add_argument("--parts", default="update,ratio,solvers,accuracy,diagnose,scale,fits")
+    parser.add_argument("--parts",
+                        default="update,ratio,solvers,accuracy,diagnose,scale,fits,frames")
     parser.add_argument("--fits-child", nargs=2, metavar=("JACOBIAN", "DIR"),
                         help=argparse.SUPPRESS)
+    parser.add_argument("--frames-child", choices=("old", "new"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.fits_child:
         print(json.dumps(_fits_child(Path(args.fits_child[1]))))
+        return
+    if args.frames_child:
+        print(json.dumps(_frames_child(args.frames_child)))
         return
     parts = set(args.parts.split(","))
     out = {}
@@ -138,6 +152,8 @@ def main():
         _scale(out)
     if "fits" in parts:
         _fits(out)
+    if "frames" in parts:
+        _frames(out)
     print(json.dumps(out, indent=1))
 
 
@@ -435,6 +451,91 @@ def _fits(out):
                                 for k in a if isinstance(a[k], dict) and "verdict" in a[k]},
                    "peak_rss_mb": {"difference": round(a["peak_rss_mb"], 1),
                                    "analytic": round(b["peak_rss_mb"], 1)}}
+
+
+def _storey_measured(model):
+    """Three-storey frame data: a 0.3 kg mass at 0.2 m along floor-2, the package's frame on
+    a 3x finer mesh, x and y at 0.33 and 0.71 of every member, 0.3 % / 0.05 % noise."""
+    from dataclasses import replace
+
+    from gfe_opt.frame import frame_mesh, frame_modes
+    from gfe_opt.frame_data import frame_measured_from_dict, observation
+    from gfe_opt.model import Effect
+
+    fine = replace(model, members=tuple(replace(m, elements=3 * m.elements)
+                                        for m in model.members))
+    truth = fine.with_effects([Effect("point_mass", {"member": "floor-2", "position": 0.2,
+                                                     "mass": 0.3})], check=False)
+    modes = frame_modes(truth, 6)
+    sensors = [{"member": m.id, "position": round(t * model.member_length(m), 4),
+                "direction": d} for m in model.members for t in (0.33, 0.71)
+               for d in ("x", "y")]
+    shapes = observation(truth, frame_mesh(truth), sensors) @ modes.shapes
+    rng = np.random.default_rng(1)
+    return frame_measured_from_dict({"sensors": sensors, "modes": [
+        {"frequency": float(f * (1 + 5e-4 * rng.standard_normal())),
+         "shape": [float(v) for v in y + 0.003 * np.abs(y).max() * rng.standard_normal(y.size)]}
+        for f, y in zip(modes.frequencies_hz, shapes.T)]}, model, "three-storey")
+
+
+def _frames_child(side: str) -> dict:
+    """One side of part 8, in this process."""
+    from gfe_opt import frame, frame_data
+    from gfe_opt.diagnosis import diagnose
+    from gfe_opt.frame_data import load_frame_measured
+    from gfe_opt.problems import portal_frame, problem_file, three_storey_frame
+
+    if side == "old":
+        frame.DENSE_SOLVE_DOFS = 10**9
+        frame.FrameDiscretisation.dense_derivatives = None
+        frame_data.OBSERVATIONS_KEPT = 0
+    noise = {"freq_noise": 0.0005, "shape_noise": 0.003}
+    out, rows = {}, []
+    portal = portal_frame()
+    storey = three_storey_frame()
+    for label, model, measured in (
+            ("portal_semirigid", portal,
+             load_frame_measured(problem_file("portal-frame-semirigid.json"), portal)),
+            ("three_storey_floor_mass", storey, _storey_measured(storey))):
+        best, _, d = _best_of(lambda m=model, x=measured: diagnose(m, x, **noise), 1)
+        found = d.together if d.together is not None else d.best
+        out[label] = {"seconds": best, "verdict": d.verdict, "suggested": d.suggested,
+                      "found": None if found is None else [
+                          {"effect": e.name, **{k: v for k, v in e.parameters.items()}}
+                          for e in found.effects]}
+        rows += _diagnosis_rows(label, d)
+    out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    out["fits"] = [(f"{r[0]} #{i}", *r[1:]) for i, r in enumerate(rows)]   # one name a fit
+    return out
+
+
+def _frames(out):
+    sides = {}
+    for side in ("old", "new"):
+        run = subprocess.run([sys.executable, __file__, "--frames-child", side],
+                             capture_output=True, text=True, check=True)
+        sides[side] = json.loads(run.stdout.strip().splitlines()[-1])
+        print(f"frames ({side}): done", file=sys.stderr, flush=True)
+    a, b = sides["old"], sides["new"]
+    worst, differ = 0.0, []
+    by_label = {row[0]: row for row in b["fits"]}
+    for la, va, _, _ in a["fits"]:
+        other = by_label.pop(la, None)
+        if other is None or len(other[1]) != len(va):
+            differ.append(la)
+            continue
+        for x, y in zip(va, other[1]):
+            worst = max(worst, abs(x - y) / max(abs(x), abs(y), 1e-300))
+    table = {key: {"old_s": round(a[key]["seconds"], 2), "new_s": round(b[key]["seconds"], 2),
+                   "speedup": round(a[key]["seconds"] / b[key]["seconds"], 2),
+                   "verdicts": [a[key]["verdict"], b[key]["verdict"]],
+                   "found": b[key]["found"]}
+             for key in ("portal_semirigid", "three_storey_floor_mass")}
+    table["three_storey_floor_mass"]["goal_s"] = 5.0
+    out["frames"] = {"table": table, "max_parameter_rel_difference": worst,
+                     "fits_on_one_side_only": differ + sorted(by_label),
+                     "peak_rss_mb": {"old": round(a["peak_rss_mb"], 1),
+                                     "new": round(b["peak_rss_mb"], 1)}}
 
 
 if __name__ == "__main__":

@@ -84,7 +84,14 @@ def test_two_semirigid_joints_are_found_at_their_joints_and_then_the_portal_agre
     assert set(found) == {"B", "C"}   # at a two-member joint either member's end is one place
     for node, stiffness in found.items():
         assert stiffness == pytest.approx(k, rel=0.1), node
-    after = update(model, measured, list(d.together.effects), **NOISE)
+    # what diagnose prints to run next (and --json's "add"): each joint spring at its place
+    assert sorted(d.add_arguments()) == sorted(
+        f"joint_spring:node={e.parameters['node']},member={e.parameters['member']}"
+        for e in d.together.effects)
+    assert d.to_json()["add"] == d.add_arguments()
+    after = update(model, measured, d.add_arguments(), **NOISE)
+    assert {e.parameters["node"]: e.parameters["stiffness"] for e in after.model.effects} \
+        == pytest.approx(found, rel=1e-4)
     again = diagnose(after.model, measured, **NOISE)
     assert again.verdict == "consistent", again.notes
 
