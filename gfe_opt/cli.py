@@ -376,10 +376,6 @@ def cmd_modes(args) -> int:
 
 def cmd_diagnose(args) -> int:
     model, measured = _inputs(args, frames=True)
-    if model.kind == "frame" and (args.plot or args.report):
-        raise GfeInputError("--plot" if args.plot else "--report", None, "diagnosis figures "
-                            "of a frame are not drawn yet (gfe-opt compare --plot draws its "
-                            "modes and where it fails)")
     candidates = None
     if args.candidates is not None:
         candidates = [c.strip() for c in args.candidates.split(",") if c.strip()]

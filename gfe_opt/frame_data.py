@@ -433,6 +433,65 @@ def frame_figures(result: FrameComparison, model: FrameModel, measured: FrameMea
     return figs
 
 
+def frame_diagnosis_figures(diagnosis, model: FrameModel, title: str, found) -> dict:
+    """``diagnose --plot`` on a frame: the effects found (``found``, as
+    :func:`gfe_opt.report.findings` gives them) drawn on the frame at their places with
+    their fitted values, and the sensors where the model as it stands fails most
+    (``diagnosis.localisation``); titled with the verdict (``title``)."""
+    from . import plots
+
+    mesh = frame_mesh(model)
+    members = [mesh.xy[nodes] for nodes in mesh.member_nodes]
+    marks = [_mark(model, kind.name, params) for kind, _, params, _, _ in found]
+    failing = []
+    for sensor, _ in diagnosis.localisation or []:
+        point, _ = sensor_places(model, [sensor])
+        failing.append((tuple(point[0]), sensor_label(sensor)))
+    return {"frame_diagnosis.png": plots.frame_findings(members, marks, failing, title)}
+
+
+def _mark(model: FrameModel, name: str, params: dict):
+    """(name, (x, y), label, member polyline or None) of an effect found on a frame: a crack
+    or a mass at its place on its member, a joint spring just off its joint along its
+    member (which member end turns), a support effect at its node, an axial stiffness along
+    its member."""
+    def along(member_id, t):
+        m = model.member(member_id)
+        (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
+        return (x0 + t * (x1 - x0), y0 + t * (y1 - y0)), m
+
+    from .effects import effect_type
+
+    kind = effect_type(name)
+
+    def unit(key):
+        u = kind.parameter(key).unit
+        return f" {u}" if u not in ("", "-") else ""
+
+    values = ", ".join(f"{k} {v:.3g}{unit(k)}" for k, v in params.items()
+                       if k != "position" and isinstance(v, (int, float)))
+    line = None
+    if "position" in params:
+        m = model.member(params["member"])
+        point, _ = along(m.id, params["position"] / model.member_length(m))
+        label = f"{name} on {m.id} at {params['position']:.3g} m: {values}"
+    elif name == "joint_spring":
+        m = model.member(params["member"])
+        t = 0.06 if params["node"] == m.start else 0.94
+        point, _ = along(m.id, t)
+        label = f"{name} at {params['node']} ({m.id}): {values}"
+    elif "node" in params:
+        point = model.nodes[params["node"]]
+        label = f"{name} at {params['node']}" + (f" in {params['direction']}"
+                                                   if "direction" in params else "") + \
+            f": {values}"
+    else:
+        point, m = along(params["member"], 0.5)
+        line = np.array([model.nodes[m.start], model.nodes[m.end]], dtype=float)
+        label = f"{name} of {m.id}: {values}"
+    return name, tuple(point), label, line
+
+
 def sensor_label(sensor: dict) -> str:
     """``node B, x`` or ``beam at 0.25 m, y``."""
     where = (f"node {sensor['node']}" if "node" in sensor

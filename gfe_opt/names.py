@@ -22,4 +22,4 @@ COMPARE_FIGURES = ("mac.png", "frequencies.png", "localisation.png")
 FRAME_COMPARE_FIGURES = ("mac.png", "frequencies.png", "frame_modes.png",
                          "frame_localisation.png")
 DIAGNOSIS_FIGURES = ("candidates.png", "stiffness_change.png", "disturbance.png",
-                     "nodal_equations.png")
+                     "nodal_equations.png", "frame_diagnosis.png")

@@ -490,3 +490,46 @@ def frame_localisation(members, points, residual, worst, labels):
     ax.margins(0.15)
     ax.set_title("where the measured shapes differ from the model's", fontsize=10)
     return fig
+
+
+#: how each effect found is marked on a frame: marker and colour (an axial stiffness is its
+#: member drawn over in colour)
+FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
+               "support_spring": ("D", "tab:brown"), "support_translation": ("D", "tab:brown"),
+               "point_mass": ("s", "tab:purple"), "axial_stiffness": (None, "tab:blue")}
+
+
+def frame_findings(members, marks, failing, title):
+    """A frame diagnosis drawn on the frame (grey): the effects found, each numbered at its
+    place (``marks``: (effect name, (x, y), label, member polyline or None)) and listed
+    with its values below, and the sensors where the model as it stands fails most
+    (``failing``: ((x, y), label), hollow circles); titled with the verdict."""
+    lines = max(len(marks), 1)
+    fig = _figure(6.4, 4.4 + 0.22 * lines)
+    ax, listing = fig.subplots(2, 1, height_ratios=(4.4, 0.22 * lines))
+    listing.set_axis_off()
+    _frame_axes(ax, members, color="0.6", lw=1.5)
+    for i, ((x, y), label) in enumerate(failing):
+        ax.scatter([x], [y], s=140, facecolors="none", edgecolors="0.25", linewidths=1.2,
+                   zorder=3, label="where the model fails most" if i == 0 else None)
+        ax.annotate(label, (x, y), fontsize=6.5, color="0.25", xytext=(0, -13),
+                    textcoords="offset points", ha="center")
+    for i, (name, (x, y), label, line) in enumerate(marks, 1):
+        marker, colour = FRAME_MARKS.get(name, ("*", "tab:green"))
+        if line is not None:
+            ax.plot(line[:, 0], line[:, 1], color=colour, lw=4, alpha=0.7, zorder=2)
+        if marker is not None:
+            ax.scatter([x], [y], marker=marker, s=90, color=colour, zorder=4,
+                       edgecolors="k", linewidths=0.5)
+        ax.annotate(str(i), (x, y), fontsize=9, color=colour, fontweight="bold",
+                    xytext=(7, 5), textcoords="offset points", zorder=5)
+        listing.text(0.0, 1.0 - (i - 1) / lines, f"{i}: {label}", fontsize=8, color=colour,
+                     va="top", transform=listing.transAxes)
+    if not marks:
+        listing.text(0.0, 1.0, "no effect found", fontsize=8, va="top",
+                     transform=listing.transAxes)
+    if failing:
+        ax.legend(fontsize=7, loc="upper right", bbox_to_anchor=(1.0, 1.12), frameon=False)
+    ax.margins(0.12)
+    ax.set_title(title, fontsize=10, fontweight="bold", loc="left")
+    return fig

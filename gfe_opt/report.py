@@ -54,6 +54,15 @@ def diagnosis_figures(diagnosis, model) -> dict:
     the fitted effects, the nodal equation coefficients and (for a crack) the identified
     Q_i against Christides–Barr Q(x)."""
     found = findings(diagnosis, model)
+    if model.kind == "frame":   # no generic update on frames yet: the effects on the frame
+        from .frame_data import frame_diagnosis_figures
+
+        figs = {"candidates.png": plots.candidate_errors(
+            diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
+            verdict=verdict_title(diagnosis))} if diagnosis.fits else {}
+        figs.update(frame_diagnosis_figures(diagnosis, model, verdict_title(diagnosis),
+                                            found))
+        return figs
     figs = {"candidates.png": plots.candidate_errors(
         diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
         verdict=verdict_title(diagnosis), length=model.length, supports=model.supports,
@@ -97,6 +106,9 @@ FIGURE_QUESTIONS = {
     "stiffness_change.png": "How does the structure differ, with no effect assumed? The "
                             "generic update's stiffness against what noise alone gives, and "
                             "the fitted effects on the structure.",
+    "frame_diagnosis.png": "Which effect, where on the frame? The effects found at their "
+                           "places with their values, and where the model as it stands fails "
+                           "most.",
     "disturbance.png": "Is it a crack? Identified Q_i against Christides–Barr Q(x).",
     "nodal_equations.png": "What does each node's updated equation say? Stiffness and mass "
                            "ratios, axial force, foundation.",

@@ -110,7 +110,8 @@ def test_diagnose_json_contract(files, capsys):
     data = json.loads(capsys.readouterr().out)
     assert set(data) == {"verdict", "baseline", "noise", "effects", "failed", "skipped",
                          "indistinguishable", "suggested", "together", "realisation",
-                         "notes", "remaining", "offered", "replace", "not_needed"}
+                         "notes", "remaining", "offered", "replace", "not_needed", "add"}
+    assert data["add"] == data["suggested"]   # on a beam the names themselves
     assert data["indistinguishable"] == [] and data["suggested"] == ["crack"]
     assert data["replace"] is None   # the model holds no effect to replace
     assert data["not_needed"] == []  # nor one to take out

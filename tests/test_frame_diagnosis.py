@@ -89,6 +89,20 @@ def test_two_semirigid_joints_are_found_at_their_joints_and_then_the_portal_agre
         f"joint_spring:node={e.parameters['node']},member={e.parameters['member']}"
         for e in d.together.effects)
     assert d.to_json()["add"] == d.add_arguments()
+    # the figure says what the text says: its title the verdict, each spring at its joint
+    # with the fitted value of the same result
+    from gfe_opt.report import diagnosis_figures, verdict_title
+
+    figs = diagnosis_figures(d, model)
+    frame_axes, listing = figs["frame_diagnosis.png"].axes
+    assert frame_axes.get_title(loc="left") == verdict_title(d) \
+        == "joint_spring + joint_spring missing"
+    labels = [t.get_text() for t in listing.texts]
+    for e in d.together.effects:
+        p = e.parameters
+        assert any(t.endswith(f"joint_spring at {p['node']} ({p['member']}): stiffness "
+                              f"{p['stiffness']:.3g} N m/rad") for t in labels), labels
+    assert figs["candidates.png"].texts[0].get_text().endswith("joint_spring missing")
     after = update(model, measured, d.add_arguments(), **NOISE)
     assert {e.parameters["node"]: e.parameters["stiffness"] for e in after.model.effects} \
         == pytest.approx(found, rel=1e-4)
