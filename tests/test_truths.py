@@ -75,6 +75,9 @@ def test_hinge_limits_and_crack_laws():
     assert 0.5 < a / b < 2.0 and a != pytest.approx(b, rel=0.05)
 
 
+@pytest.mark.slow   # generates all 170 cases (92 s here): a check of the generator of the
+# campaign (scripts/bench_diagnosis.py, itself a study), run with the slow studies
+# (`python -m pytest -m slow`, in .ci/run); test_draw_is_reproducible stays in the suite
 def test_campaign_is_fixed_and_every_case_is_valid():
     first = campaign(subset=40)
     again = campaign(subset=40)
