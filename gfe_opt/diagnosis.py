@@ -180,18 +180,22 @@ def shape_correlation(model: Model, measured: MeasuredModes, noise: Noise, C=Non
     if r is None:
         return 1.0
     shapes = r.reshape(measured.n_modes, -1)[:, 1:]
-    if model.kind == "frame":
+    frame = model.kind == "frame"
+    if frame:
         from .frame_data import neighbour_pairs
 
         a, b = neighbour_pairs(model, measured.sensors)
+        if a.size == 0:
+            return 0.0
     else:   # along the beam
         shapes = shapes[:, np.argsort(measured.x)]
-        a, b = np.arange(shapes.shape[1] - 1), np.arange(1, shapes.shape[1])
-    if shapes.shape[1] < 3 or a.size == 0:
+    if shapes.shape[1] < 3:
         return 0.0
     shapes = shapes - shapes.mean(axis=1, keepdims=True)
     den = float(np.sum(shapes**2))
-    return float(np.sum(shapes[:, a] * shapes[:, b]) / den) if den > 0 else 0.0
+    # a beam's neighbours as slices (the sums in the order they always had)
+    products = shapes[:, a] * shapes[:, b] if frame else shapes[:, 1:] * shapes[:, :-1]
+    return float(np.sum(products) / den) if den > 0 else 0.0
 
 
 # -------------------------------------------------------------------------------------------
