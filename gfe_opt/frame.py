@@ -387,7 +387,8 @@ def _as_effect(raw: dict):
 
 
 def check_repeats(effects, where) -> None:
-    """One joint spring a member end, one support effect a node and direction."""
+    """One joint spring a member end, one support effect a node and direction, one axial
+    stiffness a member."""
     seen = {}
     for i, e in enumerate(effects):
         key = _effect_key(e)
@@ -400,14 +401,14 @@ def check_repeats(effects, where) -> None:
 def _effect_key(effect) -> tuple | None:
     """What two instances of a frame effect may not share (a crack may repeat)."""
     e = {"effect": effect.name, **effect.parameters}
+    if e["effect"] in ("crack", "point_mass"):
+        return None
+    if e["effect"] == "axial_stiffness":
+        return ("axial_stiffness", e["member"]) if "member" in e else None
     if "node" not in e:
         return None   # --add without a place: every place is tried
     if e["effect"] == "joint_spring":
         return ("joint_spring", e["member"], e["node"])
-    if e["effect"] == "axial_stiffness":
-        return ("axial_stiffness", e["member"])
-    if e["effect"] in ("crack", "point_mass"):
-        return None
     return (e["effect"], e["node"], e.get("direction"))
 
 

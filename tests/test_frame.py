@@ -176,6 +176,8 @@ def test_supports_that_give_against_the_exact_solution_and_their_limits():
          "stiffness": 1.0}]})), "effects[0].node"),
     (lambda d: d.update({"effects": [{"effect": "joint_spring", "member": "beam",
                                       "node": "B", "stiffness": 10.0}] * 2}), "effects[1]"),
+    (lambda d: d.update({"effects": [{"effect": "axial_stiffness", "member": "beam",
+                                      "ratio": 0.5}] * 2}), "effects[1]"),
 ])
 def test_bad_frame_files_are_one_line_naming_the_key(change, key):
     import tomllib
