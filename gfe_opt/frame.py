@@ -614,8 +614,8 @@ def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
         dof, k = zip(*mesh.grounded)
         K = K + sp.csr_matrix((k, (dof, dof)), shape=shape)
     masses = [e for e in model.raw_effects if e["effect"] == "point_mass"]
-    if masses:
-        from .frame_data import observation
+    if masses:   # not the kept observations: a fitted mass moves at every evaluation
+        from .frame_data import build_observation as observation
 
         # m (cx cxᵀ + cy cyᵀ): the mass moves with the member's x and y displacement at its
         # place (the element's shape functions there, as a sensor reads them)

@@ -53,7 +53,7 @@ class FrameMeasured(ModeCounts):
     def n_neighbour_pairs(self) -> int:
         """Pairs of neighbours in the whiteness test of the shape residuals: sensors of one
         direction are a chain along the structure (:func:`neighbour_pairs`)."""
-        return max(self.n_sensors - len({str(s["direction"]) for s in self.sensors}), 0)
+        return max(self.n_sensors - len({chain_key(s) for s in self.sensors}), 0)
 
 
 def load_frame_measured(path, model: FrameModel) -> FrameMeasured:
@@ -214,17 +214,18 @@ def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
     and set of sensors, a copy returned."""
     key = (repr(sensors), mesh.n_dof, mesh.element_dofs.tobytes(), mesh.xy.tobytes(),
            tuple((m.id, m.elements) for m in model.members))
-    C = _OBSERVATIONS.get(key)
+    C = _OBSERVATIONS.pop(key, None)   # kept, it goes back in as the newest
     if C is None:
-        C = _observation(model, mesh, sensors)
+        C = build_observation(model, mesh, sensors)
         while _OBSERVATIONS and len(_OBSERVATIONS) >= OBSERVATIONS_KEPT:
-            _OBSERVATIONS.pop(next(iter(_OBSERVATIONS)))
-        if OBSERVATIONS_KEPT > 0:
-            _OBSERVATIONS[key] = C
+            _OBSERVATIONS.pop(next(iter(_OBSERVATIONS)))   # the least recently used
+    if OBSERVATIONS_KEPT > 0:
+        _OBSERVATIONS[key] = C
     return C.copy()
 
 
-def _observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
+def build_observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
+    """:func:`observation` built anew (not kept)."""
     rows, cols, vals = [], [], []
     member_index = {m.id: k for k, m in enumerate(model.members)}
     for i, s in enumerate(sensors):
@@ -373,6 +374,11 @@ def sensor_order(model: FrameModel, sensors) -> np.ndarray:
     return np.array(sorted(range(len(keys)), key=lambda k: keys[k]), dtype=int)
 
 
+def chain_key(sensor: dict) -> str:
+    """The chain of the whiteness test a sensor belongs to: its direction."""
+    return str(sensor["direction"])
+
+
 def neighbour_pairs(model: FrameModel, sensors) -> tuple[np.ndarray, np.ndarray]:
     """Neighbouring sensors for the whiteness test: the sensors of each direction in order
     along the structure (:func:`sensor_order`), each with the next of the same direction.
@@ -380,8 +386,8 @@ def neighbour_pairs(model: FrameModel, sensors) -> tuple[np.ndarray, np.ndarray]
     correlates a component along the structure, not one component with the other."""
     order = sensor_order(model, sensors)
     a, b = [], []
-    for d in dict.fromkeys(str(s["direction"]) for s in sensors):
-        chain = [i for i in order if str(sensors[i]["direction"]) == d]
+    for d in dict.fromkeys(chain_key(s) for s in sensors):
+        chain = [i for i in order if chain_key(sensors[i]) == d]
         a += chain[:-1]
         b += chain[1:]
     return np.array(a, dtype=int), np.array(b, dtype=int)

@@ -227,6 +227,14 @@ def frame_member_scale(model, node: str, power: int) -> float:
     return m.E * m.inertia / model.member_length(m) ** power
 
 
+def frame_position_variable(model, member, ends=()) -> Variable:
+    """A place along a frame ``member``: x / its length in [0, 1], grid at 19 interior
+    places (and ``ends``, 0 or 1, where the effect may sit on a joint)."""
+    length = model.member_length(member)
+    return Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)) + tuple(ends),
+                    scale=lambda m: length)
+
+
 def nominal_rigidity(model) -> float:
     """EI (beam) or EA (bar) of the model file's section and E, without effects [N m², N]:
     the fixed scale of the order-one variables."""
@@ -280,9 +288,11 @@ class EffectType:
         """Checked parameters (every key, or with ``partial`` those given); raises
         :class:`GfeInputError` naming the field and the allowed range."""
         if model.kind == "frame" and model.kind not in self.kinds:
+            from . import EFFECTS
+
+            taken = [n for n, e in EFFECTS.items() if "frame" in e.kinds]
             raise GfeInputError(where, f"{prefix}effect", f"effect {self.name!r} is not "
-                                "fitted on frames yet (a frame's update takes crack, "
-                                "joint_spring, support_spring and support_translation)")
+                                f"fitted on frames yet (a frame takes {', '.join(taken)})")
         if model.kind == "frame":
             return self._validate_frame(model, params, where, prefix, partial)
         if model.kind not in self.kinds:

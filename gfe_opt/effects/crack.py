@@ -12,6 +12,7 @@ from .base import (
     Parameter,
     Variable,
     check_not_on_support,
+    frame_position_variable,
     position_variable,
 )
 
@@ -56,11 +57,9 @@ class Crack(EffectType):
                              support=(x_c - CRACK_REACH * decay, x_c + CRACK_REACH * decay))
 
     def variables(self, model, fixed):
-        if model.kind == "frame":   # x / member length, inside the member
-            length = model.member_length(model.member(fixed["member"]))
-            place = Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)),
-                             scale=lambda m: length)
-            return [place, Variable("depth_ratio", 0.01, 0.9, (0.2, 0.45, 0.7))]
+        if model.kind == "frame":   # inside the member
+            return [frame_position_variable(model, model.member(fixed["member"])),
+                    Variable("depth_ratio", 0.01, 0.9, (0.2, 0.45, 0.7))]
         return [position_variable(),
                 Variable("depth_ratio", 0.01, 0.9, (0.2, 0.45, 0.7))]
 

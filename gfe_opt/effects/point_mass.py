@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from .base import (
     FIXED_TRANSLATION,
     EffectType,
     Parameter,
     Variable,
     check_not_on_support,
+    frame_position_variable,
     position_variable,
 )
 
@@ -63,13 +62,11 @@ def _frame_variables(model, member):
     support holds in both translations) and the mass in units of the member's own."""
     from ..frame import SUPPORT_TYPES
 
-    length = model.member_length(member)
     supports = dict(model.supports)
     ends = tuple(float(t) for t, node in ((0, member.start), (1, member.end))
                  if not {0, 1} <= set(SUPPORT_TYPES.get(supports.get(node), ())))
-    own = member.rho * member.area * length
-    return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)) + ends,
-                     scale=lambda m: length),
+    own = member.rho * member.area * model.member_length(member)
+    return [frame_position_variable(model, member, ends),
             Variable("mass", 1e-4, 3.0, (0.05, 0.2, 0.5), scale=lambda m: own)]
 
 
