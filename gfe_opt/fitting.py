@@ -402,10 +402,13 @@ class Fit:
 
 
 def jsonable(params: dict) -> dict:
-    """Parameters with numpy values as floats, infinite σ as null (valid JSON)."""
+    """Parameters with numpy values as floats, infinite σ as null (valid JSON); nested
+    lists and dicts (a frame's sensor in ``remaining``) likewise."""
     def one(v):
         if isinstance(v, (list, tuple, np.ndarray)):
             return [one(x) for x in v]
+        if isinstance(v, dict):
+            return {k: one(x) for k, x in v.items()}
         if isinstance(v, str):
             return v
         v = float(v)

@@ -323,17 +323,20 @@ def parse_effect(text: str, model: Model, where: str = "--add") -> Effect:
 
     name, _, rest = text.partition(":")
     kind = effect_type(name.strip(), where, None)
+    # on a frame the place too (crack:member=beam)
+    keys = [p.name for p in (kind.all_parameters if model.kind == "frame" else
+                             kind.parameters)]
     params = {}
     for item in rest.split(",") if rest.strip() else []:
         key, eq, value = (part.strip() for part in item.partition("="))
         if not eq or not value:
             raise GfeInputError(where, text, f"expected key=value, got {item!r}")
-        if key not in kind.keys:
+        if key not in keys:
             try:
-                no_unknown({key: None}, set(kind.keys), where, "")
+                no_unknown({key: None}, set(keys), where, "")
             except GfeInputError as exc:
                 raise GfeInputError(where, text, f"{key}: {exc.problem} ({name} takes "
-                                    f"{', '.join(kind.keys)})") from None
+                                    f"{', '.join(keys)})") from None
         if key in params:
             raise GfeInputError(where, text, f"{key} is given twice")
         rule = kind.parameter(key).rule

@@ -511,7 +511,7 @@ def frame_findings(members, marks, failing, title):
     _frame_axes(ax, members, color="0.6", lw=1.5)
     for i, ((x, y), label) in enumerate(failing):
         ax.scatter([x], [y], s=140, facecolors="none", edgecolors="0.25", linewidths=1.2,
-                   zorder=3, label="where the model fails most" if i == 0 else None)
+                   zorder=3, label="where the model as it stands fails most" if i == 0 else None)
         ax.annotate(label, (x, y), fontsize=6.5, color="0.25", xytext=(0, -13),
                     textcoords="offset points", ha="center")
     for i, (name, (x, y), label, line) in enumerate(marks, 1):

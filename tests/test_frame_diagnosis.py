@@ -5,6 +5,7 @@ model is the package's finite-element frame without the effect.  Issue 24's sett
 modes, two points a member in x and y and the joints, 0.3 % shape and 0.05 % frequency
 noise."""
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -16,6 +17,7 @@ from gfe_opt.frame import frame_modes
 from gfe_opt.frame_data import frame_measured_from_dict, load_frame_measured, neighbour_pairs
 from gfe_opt.model import Effect
 from gfe_opt.problems import portal_frame, problem_file
+from gfe_opt.text import format_diagnosis
 
 from .frame_reference import ExactFrame
 
@@ -58,11 +60,23 @@ def _guess(model, effects):
     return frame_modes(fine.with_effects(effects, check=False), 6).frequencies_hz
 
 
+def _diagnose(model, measured, **noise):
+    """diagnose, its text and its JSON (a frame's sensors in "remaining") as the CLI
+    prints them."""
+    d = diagnose(model, measured, **noise)
+    text = format_diagnosis(d, model)
+    doc = json.loads(json.dumps(d.to_json()))
+    assert doc["verdict"] == d.verdict and doc["add"] == d.add_arguments()
+    for arg in d.add_arguments():
+        assert f"--add {arg}" in text
+    return d
+
+
 @pytest.mark.parametrize("seed", [11, 12])
 def test_no_false_alarm_on_a_portal_that_is_as_modelled(seed):
     model = portal_frame()
     measured = _measured(model, _exact(model), _guess(model, []), _sensors(model), seed)
-    d = diagnose(model, measured, **NOISE)
+    d = _diagnose(model, measured, **NOISE)
     assert d.verdict == "consistent", d.notes
 
 
@@ -77,7 +91,7 @@ def test_two_semirigid_joints_are_found_at_their_joints_and_then_the_portal_agre
              for n in ("B", "C")]
     exact = _exact(model, [("B", beam, k), ("C", beam, k)])
     measured = _measured(model, exact, _guess(model, truth), _sensors(model), 5)
-    d = diagnose(model, measured)
+    d = _diagnose(model, measured)
     assert d.verdict == "effect_found"
     assert d.suggested == ["joint_spring", "joint_spring"]
     found = {e.parameters["node"]: e.parameters["stiffness"] for e in d.together.effects}
@@ -118,13 +132,13 @@ def test_a_clamp_that_gives_is_a_support_spring_at_its_node():
     truth = [Effect("support_spring", {"node": "A", "stiffness": k})]
     exact = _exact(model, ground_springs=[("A", 2, k)])
     measured = _measured(model, exact, _guess(model, truth), _sensors(model), 7)
-    d = diagnose(model, measured, **NOISE)
+    d = _diagnose(model, measured, **NOISE)
     assert d.verdict == "effect_found"
     best = d.together.effects[-1] if d.together is not None else d.best.effects[-1]
     assert d.suggested == ["support_spring"], d.notes
     assert best.parameters["node"] == "A"
     assert best.parameters["stiffness"] == pytest.approx(k, rel=0.1)
-    after = update(model, measured, [best], **NOISE)
+    after = update(model, measured, d.add_arguments(), **NOISE)   # as printed
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
@@ -151,13 +165,13 @@ def test_a_crack_near_a_column_base_is_found_on_that_column_at_its_place():
 
     bracket = [Effect("crack", {"member": "left-column", "position": a, "depth_ratio": 0.5})]
     measured = _measured(model, exact, _guess(model, bracket), _sensors(model), 9, where)
-    d = diagnose(model, measured, **NOISE)
+    d = _diagnose(model, measured, **NOISE)
     assert d.verdict == "effect_found", d.notes
     assert d.suggested[0] == "crack"
     crack = (d.together or d.best).effects[0]
     assert crack.parameters["member"] == "left-column"
     assert abs(crack.parameters["position"] - a) < 0.02 * 0.3
-    after = update(model, measured, [crack], **NOISE)
+    after = update(model, measured, d.add_arguments(), **NOISE)   # as printed
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
@@ -171,7 +185,7 @@ def test_a_mass_added_at_a_joint_is_a_point_mass_there():
     exact = ExactFrame(exact.nodes, exact.members, dict(model.supports), (),
                        exact.member_ids, (), [("C", mass)])
     measured = _measured(model, exact, _guess(model, truth), _sensors(model), 13)
-    d = diagnose(model, measured, **NOISE)
+    d = _diagnose(model, measured, **NOISE)
     assert d.verdict == "effect_found", d.notes
     assert d.suggested == ["point_mass"], d.notes
     found = d.best.effects[-1].parameters
@@ -180,7 +194,7 @@ def test_a_mass_added_at_a_joint_is_a_point_mass_there():
     at = next((node for x, node in end.items() if abs(found["position"] - x) < 0.02 * 0.4), None)
     assert at == "C", found
     assert found["mass"] == pytest.approx(mass, rel=0.1)
-    after = update(model, measured, [d.best.effects[-1]], **NOISE)
+    after = update(model, measured, d.add_arguments(), **NOISE)   # as printed
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
@@ -212,13 +226,13 @@ def test_a_loose_brace_is_a_lower_axial_stiffness_of_that_brace():
                        [m.id for m in model.members])
     truth = [Effect("axial_stiffness", {"member": "brace", "ratio": ratio})]
     measured = _measured(model, exact, _guess(model, truth), _sensors(model), 17)
-    d = diagnose(model, measured, **NOISE)
+    d = _diagnose(model, measured, **NOISE)
     assert d.verdict == "effect_found", d.notes
     assert d.suggested == ["axial_stiffness"], d.notes
     found = d.best.effects[-1].parameters
     assert found["member"] == "brace"
     assert found["ratio"] == pytest.approx(ratio, rel=0.1)
-    after = update(model, measured, [d.best.effects[-1]], **NOISE)
+    after = update(model, measured, d.add_arguments(), **NOISE)   # as printed
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
