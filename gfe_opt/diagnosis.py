@@ -1345,6 +1345,15 @@ def _noise_notes(est: NoiseEstimate, verdict: str, measured) -> list[str]:
         elif verdict == "consistent" and not est.given:
             notes.append("the model agrees with the test at the noise the data imply; give "
                          "--freq-noise/--shape-noise if the test's noise is known")
+        elif verdict == "unexplained" and est.given and ratio_f <= FREQ_NOISE_LIMIT:
+            # what is left looks like noise, only more of it than stated: say so, rather
+            # than leave "none of the effects I know" as the last word
+            notes.append(f"the remaining shape residuals are uncorrelated from sensor to "
+                         f"sensor ({est.correlation:.2f}) and the frequencies within "
+                         f"{FREQ_NOISE_LIMIT:g} times the stated noise: noise larger than "
+                         "stated looks like it too; if the test's noise is that large, "
+                         f"diagnose again with --shape-noise {est.implied_shape:.2g} "
+                         f"--freq-noise {est.implied_freq:.2g}")
     return notes
 
 

@@ -173,3 +173,27 @@ def test_a_present_effect_the_others_make_unnecessary_is_said_and_can_be_dropped
     assert [e.name for e in after.model.effects] == ["crack"]
     assert after.after.chi2 - d.current.chi2 < d.not_needed[0]["needed"]
     assert diagnose(after.model, measured, **NOISE).not_needed == []
+
+
+def test_unexplained_with_white_residuals_at_more_noise_than_stated_says_so():
+    """What remains is uncorrelated and the frequencies are within a test's precision, only
+    more of both than stated: the notes say noise larger than stated looks like that and
+    how to diagnose at the level the data imply; correlated residuals or frequencies far off
+    get no such note."""
+    from types import SimpleNamespace
+
+    from gfe_opt.diagnosis import NoiseEstimate, _noise_notes
+
+    measured = SimpleNamespace(frequency_only=False, n_sensors=14, n_modes=6)
+    white_est = NoiseEstimate(0.0005, 0.003, True, 0.00098, 0.0046, 1.0, -0.07)
+    notes = _noise_notes(white_est, "unexplained", measured)
+    assert any("noise larger than stated" in n and "--shape-noise 0.0046" in n
+               and "--freq-noise 0.00098" in n for n in notes), notes
+    correlated = NoiseEstimate(0.0005, 0.003, True, 0.00098, 0.0046, 1.0, 0.8)
+    assert not any("noise larger than stated" in n
+                   for n in _noise_notes(correlated, "unexplained", measured))
+    far = NoiseEstimate(0.0005, 0.003, True, 0.005, 0.0046, 1.0, -0.07)
+    assert not any("noise larger than stated" in n
+                   for n in _noise_notes(far, "unexplained", measured))
+    assert not any("noise larger than stated" in n
+                   for n in _noise_notes(white_est, "effect_found", measured))
