@@ -777,9 +777,9 @@ def write_frame_modes(model: FrameModel, n_modes: int, path, *, force: bool = Fa
 
     path = check_output_path(path, force, protect, kind="modes")
     suffix = path.suffix.lower()
-    if suffix not in (".json", ".uff", ".unv"):
-        raise GfeInputError(str(path), None, "a frame's modes are written as .json or "
-                            ".uff/.unv (CSV for frames is not there yet)")
+    if suffix not in (".json", ".csv", ".uff", ".unv"):
+        raise GfeInputError(str(path), None, "a frame's modes are written as .json, .csv or "
+                            ".uff/.unv")
     disc = FrameDiscretisation(model)
     mesh = disc.mesh
     modes = frame_modes(model, min(n_modes + 3, disc.free.size - 1), disc)
@@ -793,10 +793,28 @@ def write_frame_modes(model: FrameModel, n_modes: int, path, *, force: bool = Fa
         text = json.dumps(doc, indent=1)
         atomic_write(path, lambda p: p.write_text(text + "\n", encoding="utf-8"),
                      replace=force)
+    elif suffix == ".csv":
+        atomic_write(path, lambda p: _write_csv(mesh, modes, elastic, sensors, p),
+                     replace=force)
     else:
         atomic_write(path, lambda p: _write_uff(mesh, modes, elastic, p), replace=force)
     rigid = int(np.sum(modes.frequencies_hz[:elastic[0]] == 0)) if elastic.size else 0
     return elastic.size, len(sensors), rigid
+
+
+def _write_csv(mesh: FrameMesh, modes, columns, sensors, path) -> None:
+    """The frame CSV (gfe_opt.frame_data): each sensor's mesh node's x, y and direction,
+    then its value in each mode."""
+    import csv
+
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(["x", "y", "direction"] + [repr(float(modes.frequencies_hz[j]))
+                                              for j in columns])
+        for sensor, dof in sensors:
+            x, y = mesh.xy[dof // 3]
+            w.writerow([repr(float(x)), repr(float(y)), sensor["direction"]]
+                       + [repr(float(modes.shapes[dof, j])) for j in columns])
 
 
 def _write_uff(mesh: FrameMesh, modes, columns, path) -> None:

@@ -11,6 +11,15 @@ member sensor's ``position`` is in metres from the member's start node.  A senso
 mesh nodes reads the member's element shape functions (linear along the member, cubic
 Hermite across it), rotated into the frame's axes.  A frequency-only file has no
 ``sensors`` and no ``shape``.
+
+CSV (``#`` starts a comment line)::
+
+    x,y,direction,<f1 Hz>,<f2 Hz>,...
+    <x m>,<y m>,<direction>,<value mode 1>,<value mode 2>,...
+
+one row per sensor: the point's coordinates in the frame's axes (placed on the frame as a
+UFF node is, :func:`locate`) and its direction as in JSON; the header row alone is a test
+of frequencies only.
 """
 
 from __future__ import annotations
@@ -65,9 +74,11 @@ def load_frame_measured(path, model: FrameModel) -> FrameMeasured:
     suffix = where.lower().rsplit(".", 1)[-1]
     if suffix in ("uff", "unv"):
         return _read_frame_uff(path, model)
+    if suffix == "csv":
+        return _read_frame_csv(path, model)
     if suffix != "json":
-        raise GfeInputError(where, None, "frame measured data are read from .json, .uff or "
-                            ".unv (README \"Plane frames\")")
+        raise GfeInputError(where, None, "frame measured data are read from .json, .csv, "
+                            ".uff or .unv (README \"Plane frames\")")
     return frame_measured_from_dict(read_json(path), model, where)
 
 
@@ -124,6 +135,60 @@ def _read_frame_uff(path, model: FrameModel) -> FrameMeasured:
     data = {"sensors": sensors, "modes": [
         {"frequency": float(m["freq"]), "shape": [float(c[i]) for c in columns]}
         for i, m in enumerate(modes)]}
+    return frame_measured_from_dict(data, model, where)
+
+
+#: the first cells of a frame CSV's header (then one frequency per mode)
+CSV_HEADER = ("x", "y", "direction")
+
+
+def _read_frame_csv(path, model: FrameModel) -> FrameMeasured:
+    """A CSV of a frame test (module docstring): each row's point placed on the frame
+    (:func:`locate`), its direction ``x``, ``y`` or degrees from x."""
+    from .measured import csv_rows, read_text
+
+    where = str(path)
+    rows = csv_rows([ln for ln in read_text(path, "measured").splitlines()
+                     if ln.strip() and not ln.lstrip().startswith("#")], where)
+    if not rows or [c.strip().lower() for c in rows[0][:3]] != list(CSV_HEADER):
+        raise GfeInputError(where, "header", "a frame's CSV starts with the header row "
+                            "x,y,direction,<f1 Hz>,<f2 Hz>,... (README \"Plane frames\")")
+    header = rows[0]
+    try:
+        freqs = [float(v) for v in header[3:]]
+    except ValueError:
+        raise GfeInputError(where, "header", "cells after x,y,direction must be frequencies "
+                            f"in Hz, got {header[3:]}") from None
+    sensors, shapes = [], []
+    for i, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise GfeInputError(where, f"row {i}", f"has {len(row)} cells, header has "
+                                f"{len(header)}")
+        try:
+            x, y, *values = [float(v) for v in row[:2] + row[3:]]
+        except ValueError:
+            raise GfeInputError(where, f"row {i}", f"non-numeric cell in {row}") from None
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise GfeInputError(where, f"row {i}", f"the point ({x:g}, {y:g}) is not finite")
+        place = locate(model, x, y)
+        if place is None:
+            raise GfeInputError(where, f"row {i}", f"at ({x:g}, {y:g}) m it lies on no member "
+                                f"of {model.name}")
+        direction = row[2].strip()
+        if direction.lower() in ("x", "y"):
+            direction = direction.lower()
+        else:
+            try:
+                direction = float(direction)
+            except ValueError:
+                raise GfeInputError(where, f"row {i}.direction", "must be x, y or an angle in "
+                                    f"degrees, got {row[2]!r}") from None
+        sensors.append({**place, "direction": direction})
+        shapes.append(values)
+    data = {"modes": [{"frequency": f} for f in freqs]}
+    if sensors:
+        data = {"sensors": sensors, "modes": [
+            {"frequency": f, "shape": [v[j] for v in shapes]} for j, f in enumerate(freqs)]}
     return frame_measured_from_dict(data, model, where)
 
 

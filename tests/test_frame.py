@@ -394,6 +394,78 @@ def test_a_uff_test_of_a_frame_reads_in_without_editing(tmp_path):
         load_frame_measured(off, model)
 
 
+def _point_of(model, sensor):
+    """A sensor's (x, y) in the frame's axes."""
+    if "node" in sensor:
+        return model.nodes[sensor["node"]]
+    m = model.member(sensor["member"])
+    (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
+    t = sensor["position"] / model.member_length(m)
+    return x0 + t * (x1 - x0), y0 + t * (y1 - y0)
+
+
+def test_a_csv_test_of_a_frame_reads_as_its_json(tmp_path):
+    """The frame CSV contract (x, y, direction, then a value per mode; the header row alone
+    for frequencies only): the semi-rigid portal's test written as CSV by hand, with an
+    oblique sensor, compares exactly as the same test in JSON; bad rows are one line naming
+    the row, exit 2 from the CLI."""
+    from gfe_opt.frame_data import compare_frame, frame_measured_from_dict, load_frame_measured
+
+    model, joints, data, _ = _portal_test(2000.0)
+    data["sensors"][5]["direction"] = 30.0
+    rows = ["# the semi-rigid portal, 6 modes", "x,y,direction," + ",".join(
+        repr(m["frequency"]) for m in data["modes"])]
+    for i, sensor in enumerate(data["sensors"]):
+        x, y = _point_of(model, sensor)
+        rows.append(f"{x!r},{y!r},{sensor['direction']}," + ",".join(
+            repr(m["shape"][i]) for m in data["modes"]))
+    path = tmp_path / "portal-test.csv"
+    path.write_text("\n".join(rows) + "\n")
+    from_csv = load_frame_measured(path, model)
+    direct = frame_measured_from_dict(data, model)
+    assert [s.get("node") or (s["member"], round(s["position"], 12)) for s in
+            from_csv.sensors] == [s.get("node") or (s["member"], s["position"]) for s in
+                                  direct.sensors]
+    assert [float(s["direction"]) if not isinstance(s["direction"], str) else s["direction"]
+            for s in from_csv.sensors] == [s["direction"] for s in direct.sensors]
+    assert np.array_equal(from_csv.shapes, direct.shapes)
+    assert np.array_equal(from_csv.frequencies_hz, direct.frequencies_hz)
+    a = compare_frame(replace(model, effects=joints), from_csv)
+    b = compare_frame(replace(model, effects=joints), direct)
+    assert [(p.test_mode, p.model_mode, p.mac) for p in a.pairs] == pytest.approx(
+        [(p.test_mode, p.model_mode, p.mac) for p in b.pairs], rel=1e-12)
+    only = tmp_path / "portal-freqs.csv"
+    only.write_text(rows[1] + "\n")
+    freqs = load_frame_measured(only, model)
+    assert freqs.shapes is None and len(freqs.frequencies_hz) == 6
+    frame = str(problem_file("portal-frame.toml"))
+    for line, where in ((rows[1].replace("x,y,direction", "x"), "header"),
+                        ("0.2,0.15,x" + ",1.0" * 6, "row 2"),      # inside the portal
+                        ("0.0,0.1,z" + ",1.0" * 6, "row 2.direction"),
+                        ("0.0,0.1,x,1.0", "row 2")):
+            bad = tmp_path / "bad.csv"
+            bad.write_text(rows[1] + "\n" + line + "\n" if where != "header" else line)
+            run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(bad)],
+                                 capture_output=True, text=True)
+            assert run.returncode == 2 and where in run.stderr, (line, run.stderr)
+            assert len(run.stderr.strip().splitlines()) == 1
+
+
+def test_gfe_opt_modes_writes_a_frame_csv_that_compares_with_its_model(tmp_path):
+    out = tmp_path / "portal.csv"
+    model = str(problem_file("portal-frame.toml"))
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "modes", model, "--out", str(out),
+                          "--modes", "5"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert out.read_text().startswith("x,y,direction,")
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", model, str(out),
+                          "--json"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    pairs = json.loads(run.stdout)["pairs"]
+    assert [(p["test_mode"], p["model_mode"]) for p in pairs] == [(i, i) for i in range(1, 6)]
+    assert all(abs(p["error_pct"]) < 1e-9 and p["mac"] > 1 - 1e-12 for p in pairs)
+
+
 def test_gfe_opt_modes_writes_a_frame_uff_that_compares_with_its_model(tmp_path):
     out = tmp_path / "portal.uff"
     model = str(problem_file("portal-frame.toml"))
