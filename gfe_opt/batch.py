@@ -2,10 +2,12 @@
 
 Each measured file in a folder (``.json``, ``.csv``, ``.uff``, ``.unv``; sorted by name) is
 one task: the diagnosis of the model against it or, with ``add``, the update of the named
-effects.  Each task becomes one row of a table (README "Batch results"): the file, its
-``label``/``time``, the verdict, every fitted parameter with its standard deviation and its
-size in standard deviations from "no effect", the error before and after, χ² per residual,
-the solver status and the seconds taken.  A set that fails (bad file, solver failure)
+effects.  The model may be a beam, a bar or a plane frame (its sets in the frame contract:
+JSON, CSV or UFF, with ``label``/``time`` as a beam's).  Each task becomes one row of a
+table (README "Batch results"): the file, its ``label``/``time``, the verdict, every fitted
+parameter with its standard deviation and its size in standard deviations from "no
+effect", the error before and after, χ² per residual, the solver status and the seconds
+taken.  A set that fails (bad file, solver failure)
 becomes a row with ``status = "error"`` and its message; the batch goes on.
 
 Where the tasks run:
@@ -115,8 +117,13 @@ def _solve(task: Task, model_path: Path, measured_path: Path, name: str) -> dict
     from .measured import load_measured
     from .model import load_model
 
-    model = load_model(model_path)
-    measured = load_measured(measured_path)
+    model = load_model(model_path, frames=True)
+    if model.kind == "frame":
+        from .frame_data import load_frame_measured
+
+        measured = load_frame_measured(measured_path, model)
+    else:
+        measured = load_measured(measured_path)
     out = {"label": measured.label, "time": None if measured.time is None
            else str(measured.time)}
     if task.add:
@@ -317,7 +324,7 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
     if workers is not None and workers < 1:
         raise GfeInputError("--workers", None, f"must be >= 1, got {workers}")
     check_input_file(Path(model_path), "model")
-    model = load_model(model_path)  # a bad model is one error, not a row per set
+    model = load_model(model_path, frames=True)  # a bad model is one error, not a row per set
     if add:
         from .model import parse_effect
 

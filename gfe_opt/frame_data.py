@@ -41,7 +41,7 @@ from .frame import (
     frame_modes,
     rotations,
 )
-from .measured import ModeCounts
+from .measured import ModeCounts, time_and_label
 
 
 @dataclass(frozen=True)
@@ -53,6 +53,8 @@ class FrameMeasured(ModeCounts):
     frequencies_hz: np.ndarray
     shapes: np.ndarray | None
     source: str = "measured"
+    time: object = None     # optional, as a beam test's: ISO 8601 text or a number
+    label: str | None = None
 
     @property
     def n_sensors(self) -> int:
@@ -145,10 +147,11 @@ CSV_HEADER = ("x", "y", "direction")
 def _read_frame_csv(path, model: FrameModel) -> FrameMeasured:
     """A CSV of a frame test (module docstring): each row's point placed on the frame
     (:func:`locate`), its direction ``x``, ``y`` or degrees from x."""
-    from .measured import csv_rows, read_text
+    from .measured import csv_rows, csv_stamp, read_text
 
     where = str(path)
-    rows = csv_rows([ln for ln in read_text(path, "measured").splitlines()
+    text = read_text(path, "measured")
+    rows = csv_rows([ln for ln in text.splitlines()
                      if ln.strip() and not ln.lstrip().startswith("#")], where)
     if not rows or [c.strip().lower() for c in rows[0][:3]] != list(CSV_HEADER):
         raise GfeInputError(where, "header", "a frame's CSV starts with the header row "
@@ -185,19 +188,21 @@ def _read_frame_csv(path, model: FrameModel) -> FrameMeasured:
                                     f"degrees, got {row[2]!r}") from None
         sensors.append({**place, "direction": direction})
         shapes.append(values)
-    data = {"modes": [{"frequency": f} for f in freqs]}
+    data = {"modes": [{"frequency": f} for f in freqs], **{
+        k: v for k, v in csv_stamp(text, where).items() if v is not None}}
     if sensors:
-        data = {"sensors": sensors, "modes": [
-            {"frequency": f, "shape": [v[j] for v in shapes]} for j, f in enumerate(freqs)]}
+        data.update(sensors=sensors, modes=[
+            {"frequency": f, "shape": [v[j] for v in shapes]} for j, f in enumerate(freqs)])
     return frame_measured_from_dict(data, model, where)
 
 
 def frame_measured_from_dict(data, model: FrameModel, where="measured") -> FrameMeasured:
     if not isinstance(data, dict):
         raise GfeInputError(where, None, "must be a JSON object with \"modes\"")
-    unknown = set(data) - {"sensors", "modes"}
+    unknown = set(data) - {"sensors", "modes", "time", "label"}
     if unknown:
         raise GfeInputError(where, sorted(unknown)[0], "unknown key")
+    stamp = time_and_label(data.get("time"), data.get("label"), where)
     sensors = data.get("sensors", [])
     if not isinstance(sensors, list):
         raise GfeInputError(where, "sensors", "must be a list of sensors")
@@ -233,7 +238,7 @@ def frame_measured_from_dict(data, model: FrameModel, where="measured") -> Frame
     order = np.argsort(freqs, kind="stable")
     return FrameMeasured(sensors=list(sensors), frequencies_hz=np.array(freqs)[order],
                          shapes=np.array(shapes, dtype=float).T[:, order] if shapes else None,
-                         source=where)
+                         source=where, **stamp)
 
 
 def _check_sensor(s, model, where, key) -> None:

@@ -256,7 +256,7 @@ def _read_json(path: Path) -> MeasuredModes:
         if key not in ("sensors", "modes", "time", "label"):
             raise GfeInputError(where, key, "unknown key (expected sensors, modes, time, "
                                 "label)")
-    stamp = _time_and_label(data.get("time"), data.get("label"), where)
+    stamp = time_and_label(data.get("time"), data.get("label"), where)
     modes = data.get("modes")
     if not isinstance(modes, list) or not modes:
         raise GfeInputError(where, "modes", "missing or empty (a list of modes)")
@@ -310,7 +310,7 @@ def _read_json(path: Path) -> MeasuredModes:
                                  np.array(shapes, dtype=float).T, where, damping), **stamp)
 
 
-def _time_and_label(time, label, where) -> dict:
+def time_and_label(time, label, where) -> dict:
     """The optional ``time`` (ISO 8601 text such as ``2026-03-01T12:00``, or a number in
     the user's unit) and ``label`` (text) of a measured set, checked."""
     if time is not None:
@@ -367,16 +367,22 @@ def _read_csv(path: Path, dof: str) -> MeasuredModes:
             raise GfeInputError(where, f"row {i}", f"non-numeric cell in {row}") from None
         x.append(vals[0])
         shapes.append(vals[1:])
+    stamp = csv_stamp(read_text(path, "measured"), where)
+    return replace(make_measured(x, dof, freqs, np.array(shapes) if x else None, where),
+                   **stamp)
+
+
+def csv_stamp(text: str, where: str) -> dict:
+    """``time`` and ``label`` of a measured CSV from its comment lines ``# time: ...`` and
+    ``# label: ...``, checked (:func:`time_and_label`)."""
     stamp = {}
-    for line in read_text(path, "measured").splitlines():
+    for line in text.splitlines():
         key, sep, value = line.lstrip().lstrip("#").partition(":")
         if line.lstrip().startswith("#") and sep and key.strip() in ("time", "label"):
             value = value.strip()
             stamp[key.strip()] = (float(value) if key.strip() == "time"
                                   and _looks_numeric(value) else value)
-    stamp = _time_and_label(stamp.get("time"), stamp.get("label"), where)
-    return replace(make_measured(x, dof, freqs, np.array(shapes) if x else None, where),
-                   **stamp)
+    return time_and_label(stamp.get("time"), stamp.get("label"), where)
 
 
 def _looks_numeric(text: str) -> bool:

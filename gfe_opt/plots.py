@@ -382,7 +382,8 @@ def trend_parameters(trend):
             if onset.effect == effect:
                 ax.axvline(x[onset.index], color="tab:red", ls="--", lw=1,
                            label=f"significant from {onset.when}")
-        ax.set_ylabel(_parameter_label(key), fontsize=8)
+        place = trend.places.get(effect)
+        ax.set_ylabel(_parameter_label(key) + (f"\n{place}" if place else ""), fontsize=8)
         ax.grid(alpha=0.3)
         handles, _ = ax.get_legend_handles_labels()
         if handles:

@@ -295,12 +295,14 @@ def format_trend(trend) -> str:
     for onset in trend.onsets:
         params = ", ".join(f"{k} = {v:.4g}" for k, v in onset.value.items()
                            if isinstance(v, (int, float)))
-        lines.append(f"{onset.effect} becomes significant at set {onset.index + 1} "
+        lines.append(f"{trend.named(onset.effect)} becomes significant at set "
+                     f"{onset.index + 1} "
                      f"({onset.file}, {onset.when}){': ' + params if params else ''}")
     if not trend.onsets:
         lines.append("no effect becomes significant during the campaign")
     if trend.from_start:
-        lines.append("significant from the first set on: " + ", ".join(trend.from_start))
+        lines.append("significant from the first set on: " + ", ".join(
+            map(trend.named, trend.from_start)))
     if trend.parameters:
         lines += ["", f"{'parameter':<28} {'first':>12} {'last':>12} {'min':>12} {'max':>12}"]
         for key, (values, _) in trend.parameters.items():

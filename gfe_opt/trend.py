@@ -52,9 +52,15 @@ class Trend:
     from_start: list                # effects significant from the first set on
     failed: list                    # (file, error)
     notes: list = field(default_factory=list)
+    places: dict = field(default_factory=dict)  # effect -> its place on a frame (text)
+
+    def named(self, effect: str) -> str:
+        """``joint_spring#2`` -> ``joint_spring#2 (node=C, member=beam)`` on a frame."""
+        return f"{effect} ({self.places[effect]})" if effect in self.places else effect
 
     def to_json(self) -> dict:
         return {"source": self.source, "sets": len(self.files), "axis": self.axis,
+                "places": dict(self.places),
                 "failed": [{"file": f, "error": e} for f, e in self.failed],
                 "onsets": [o.to_json() for o in self.onsets],
                 "present_from_start": list(self.from_start),
@@ -97,7 +103,26 @@ def trend(rows, source="results") -> Trend:
     return Trend(str(source), axis, x, ticks, [r["file"] for r in ok], parameters,
                  np.array([_number(r.get("freq_error_before_pct")) for r in ok]),
                  np.array([_number(r.get("freq_error_after_pct")) for r in ok]),
-                 onsets, from_start, failed, notes)
+                 onsets, from_start, failed, notes, _places(ok))
+
+
+#: the text columns that place an effect on a frame (batch rows), in the order printed
+PLACE_KEYS = ("node", "member", "direction")
+
+
+def _places(rows) -> dict:
+    """Each effect's place on a frame from its text columns (``joint_spring#2.node``...),
+    where every set agrees ("varies" where they do not)."""
+    out = {}
+    for effect in sorted({e for r in rows for e in _effects_of(r)}):
+        seen = {tuple((k, r.get(f"{effect}.{k}")) for k in PLACE_KEYS
+                      if isinstance(r.get(f"{effect}.{k}"), str)) for r in rows}
+        seen.discard(())
+        if len(seen) == 1:
+            out[effect] = ", ".join(f"{k}={v}" for k, v in seen.pop())
+        elif seen:
+            out[effect] = "place varies between sets"
+    return out
 
 
 def _order(rows, notes):

@@ -587,3 +587,56 @@ def test_cli_update_on_a_frame(tmp_path):
         "--add", "joint_spring:node=B,member=beam"] * 2, capture_output=True, text=True)
     assert twice.returncode == 2 and "repeats" in twice.stderr
     assert len(twice.stderr.strip().splitlines()) == 1
+
+
+def test_batch_on_a_frame_follows_joints_that_loosen(tmp_path):
+    """A monitoring campaign on a frame (``gfe-opt batch``): three tests of the portal, its
+    beam's joints loosening (4000, 2000, 1000 N m/rad, the exact solution with noise; JSON
+    and CSV sets, each with its time), each updated with both joint springs: every row
+    fits its joints within 10 % and 3 sigma, the table follows the loosening, and a set
+    with a bad sensor is an error row while the batch goes on."""
+    from gfe_opt.batch import run_batch
+
+    folder = tmp_path / "sets"
+    folder.mkdir()
+    truths = {"t1.json": 4000.0, "t2.csv": 2000.0, "t3.json": 1000.0}
+    for seed, (name, k) in enumerate(truths.items()):
+        model, _, data, _ = _portal_test(k, seed=10 + seed)
+        when = f"2026-03-0{3 - seed}T12:00"       # named in the reverse order of time
+        if name.endswith(".json"):
+            (folder / name).write_text(json.dumps({**data, "time": when}))
+        else:
+            rows = [f"# time: {when}", "x,y,direction," + ",".join(
+                repr(m["frequency"]) for m in data["modes"])]
+            for i, sensor in enumerate(data["sensors"]):
+                x, y = _point_of(model, sensor)
+                rows.append(f"{x!r},{y!r},{sensor['direction']}," + ",".join(
+                    repr(m["shape"][i]) for m in data["modes"]))
+            (folder / name).write_text("\n".join(rows) + "\n")
+    data["sensors"][0] = {"node": "Z", "direction": "x"}
+    (folder / "t4.json").write_text(json.dumps(data))
+    add = ("joint_spring:node=B,member=beam", "joint_spring:node=C,member=beam")
+    result = run_batch(problem_file("portal-frame.toml"), folder, tmp_path / "joints.csv",
+                       add=add, workers=2)
+    rows = {r["file"]: r for r in result.rows}
+    assert rows["t4.json"]["status"] == "error" and "sensors[0].node" in rows["t4.json"]["error"]
+    for name, k in truths.items():
+        row = rows[name]
+        assert row["status"] == "ok", row["error"]
+        assert (row["joint_spring.node"], row["joint_spring#2.node"]) == ("B", "C")
+        for prefix in ("joint_spring", "joint_spring#2"):
+            fitted, sigma = row[f"{prefix}.stiffness"], row[f"{prefix}.stiffness.sigma"]
+            assert abs(fitted / k - 1) < 0.10 and abs(fitted - k) < 3 * sigma, (name, row)
+        assert row["freq_error_after_pct"] < 0.2 * row["freq_error_before_pct"]
+    assert rows["t1.json"]["joint_spring.stiffness"] > rows["t2.csv"]["joint_spring.stiffness"] \
+        > rows["t3.json"]["joint_spring.stiffness"]
+    from gfe_opt.text import format_trend
+    from gfe_opt.trend import trend
+
+    assert [rows[n]["time"] for n in truths] == [f"2026-03-0{i}T12:00" for i in (3, 2, 1)]
+    summary = trend(result.rows)       # which joint is which, printed and in JSON
+    assert summary.axis == "time" and summary.files == ["t3.json", "t2.csv", "t1.json"]
+    assert summary.places == {"joint_spring": "node=B, member=beam",
+                              "joint_spring#2": "node=C, member=beam"}
+    assert "joint_spring#2 (node=C, member=beam)" in format_trend(summary)
+    assert summary.to_json()["places"] == summary.places
