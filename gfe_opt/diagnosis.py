@@ -373,16 +373,20 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
         key = repr({k: start.get(k) for k in kind.fixed_keys()})
         if start not in groups.setdefault(key, []):
             groups[key].append(start)
-    best = None
+    best, fits = None, []
     for starts in groups.values():
         fit = fit_effects(model, measured, [*extra, Effect(name, starts[0])], noise=noise,
                           name=name, alternatives=starts[1:],
                           multistart=True if (extra or thorough) and measured.frequency_only
                           else "auto")
+        fits.append(fit)
         if best is None or _preferred(fit, best):
             best = fit
     if extra:
         best.added = len(model.effects) + len(extra)
+    if model.kind == "frame":   # each place of the frame is a group of its own
+        best.other_places = [(f.effects, f.misfit.chi2) for f in fits
+                             if f is not best and f.success]
     return best
 
 
@@ -1180,8 +1184,35 @@ def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
     mirror = _mirror(best, measured, noise, C, sel)
     if mirror is not None:
         notes.append(mirror)
+    places = _other_places(best, measured, sel)
+    if places is not None:
+        notes.append(places)
     notes += equivalent_notes(best, measured)
     return notes
+
+
+def _other_places(fit, measured, sel) -> str | None:
+    """On a frame, a sentence when the added effect fits as well (χ² within
+    :data:`ALIKE_CHI2` noise floors) at another place of the frame (a symmetric portal's
+    other corner): the data cannot tell those places apart."""
+    if fit.added is None or fit.model.kind != "frame" or not fit.other_places:
+        return None
+    from .frame_data import effect_place
+
+    model = fit.model
+    here = effect_place(model, fit.effects[fit.added])
+    alike = {}
+    for effects, chi2 in sorted(fit.other_places, key=lambda item: item[1]):
+        place = effect_place(model, effects[fit.added])
+        if chi2 - fit.misfit.chi2 < ALIKE_CHI2 * sel.floor and place != here:
+            alike.setdefault(place, chi2)
+    if not alike:
+        return None
+    n = max(fit.misfit.n_residuals, 1)
+    what = "frequencies" if measured.frequency_only else "data"
+    return (f"the {fit.name} at {here} fits as well at " + ", ".join(
+        f"{place} (χ²/n {chi2 / n:.3g} against {fit.misfit.chi2_per_residual:.3g})"
+        for place, chi2 in alike.items()) + f": the {what} cannot tell these places apart")
 
 
 def _other_end(effects, chi2, other, sel) -> bool:
@@ -1455,11 +1486,15 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
         elif hint is None:
             places = compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
             hint = places[0][0] / model.length if places else 0.5
-        where = e.parameters.get("position")
+        where, member = e.parameters.get("position"), e.parameters.get("member")
+        if where is None or model.kind == "frame" and member is None:
+            along = hint
+        else:   # along the structure, or along its member on a frame
+            along = where / (model.member_length(model.member(member))
+                             if model.kind == "frame" else model.length)
         # fitted on top of the instances added before it: a second crack finds the second
-        single = _fit_candidate(model, measured, e.name, noise,
-                                where / model.length if where is not None else hint,
-                                given=e.parameters, extra=tuple(starts))
+        single = _fit_candidate(model, measured, e.name, noise, along, given=e.parameters,
+                                extra=tuple(starts))
         starts.append(Effect(e.name, {**single.parameters, **e.parameters}))
     if single is not None and single.success:
         # the last candidate's own fit is already the fit of every effect (the others

@@ -350,6 +350,9 @@ class Fit:
     notes: list = field(default_factory=list)
     mirror_position: float | None = None   # fits as well at x -> L - x (set by diagnosis)
     equivalent: list = field(default_factory=list)  # other effect sets that fit as well
+    #: on a frame, the candidate's fits at its other places: (effects, χ²) each (set by the
+    #: diagnosis; a place that fits as well is said)
+    other_places: list = field(default_factory=list)
     unidentified: list = field(default_factory=list)  # parameters these data do not estimate
     #: per effect, parameters that ended on a bound of their range: {key: "at least" |
     #: "at most"} (the data tell one side only)

@@ -526,6 +526,26 @@ def frame_diagnosis_figures(diagnosis, model: FrameModel, title: str, found) -> 
     return {"frame_diagnosis.png": plots.frame_findings(members, marks, failing, title)}
 
 
+def effect_place(model: FrameModel, effect) -> str:
+    """Where an effect sits on a frame, in words: ``node C`` (an effect at a named node, or
+    along a member within 2 % of its length of one: a mass at either member's end of a
+    joint is one place), ``beam at 0.132 m``, or the member (an axial stiffness).  A joint
+    spring's place is its joint and member end."""
+    p = effect.parameters
+    if effect.name == "joint_spring":
+        return f"node {p['node']} ({p['member']}'s end)"
+    if "position" in p and "member" in p:
+        m = model.member(p["member"])
+        length = model.member_length(m)
+        for node, at in ((m.start, 0.0), (m.end, length)):
+            if abs(p["position"] - at) <= 0.02 * length:
+                return f"node {node}"
+        return f"{m.id} at {p['position']:.3g} m"
+    if "node" in p:
+        return f"node {p['node']}" + (f" in {p['direction']}" if "direction" in p else "")
+    return str(p.get("member", "the frame"))
+
+
 def _mark(model: FrameModel, name: str, params: dict):
     """(name, (x, y), label, member polyline or None) of an effect found on a frame: a crack
     or a mass at its place on its member, a joint spring just off its joint along its
