@@ -404,6 +404,17 @@ def _point_of(model, sensor):
     return x0 + t * (x1 - x0), y0 + t * (y1 - y0)
 
 
+def _csv_of(model, data, comments=()) -> str:
+    """A frame test (the JSON contract's dict) as the frame CSV contract, floats in full."""
+    rows = [*comments, "x,y,direction," + ",".join(repr(m["frequency"])
+                                                  for m in data["modes"])]
+    for i, sensor in enumerate(data["sensors"]):
+        x, y = _point_of(model, sensor)
+        rows.append(f"{x!r},{y!r},{sensor['direction']}," + ",".join(
+            repr(m["shape"][i]) for m in data["modes"]))
+    return "\n".join(rows) + "\n"
+
+
 def test_a_csv_test_of_a_frame_reads_as_its_json(tmp_path):
     """The frame CSV contract (x, y, direction, then a value per mode; the header row alone
     for frequencies only): the semi-rigid portal's test written as CSV by hand, with an
@@ -413,14 +424,10 @@ def test_a_csv_test_of_a_frame_reads_as_its_json(tmp_path):
 
     model, joints, data, _ = _portal_test(2000.0)
     data["sensors"][5]["direction"] = 30.0
-    rows = ["# the semi-rigid portal, 6 modes", "x,y,direction," + ",".join(
-        repr(m["frequency"]) for m in data["modes"])]
-    for i, sensor in enumerate(data["sensors"]):
-        x, y = _point_of(model, sensor)
-        rows.append(f"{x!r},{y!r},{sensor['direction']}," + ",".join(
-            repr(m["shape"][i]) for m in data["modes"]))
+    text = _csv_of(model, data, ["# the semi-rigid portal, 6 modes"])
+    rows = text.splitlines()
     path = tmp_path / "portal-test.csv"
-    path.write_text("\n".join(rows) + "\n")
+    path.write_text(text)
     from_csv = load_frame_measured(path, model)
     direct = frame_measured_from_dict(data, model)
     assert [s.get("node") or (s["member"], round(s["position"], 12)) for s in
@@ -443,42 +450,33 @@ def test_a_csv_test_of_a_frame_reads_as_its_json(tmp_path):
                         ("0.2,0.15,x" + ",1.0" * 6, "row 2"),      # inside the portal
                         ("0.0,0.1,z" + ",1.0" * 6, "row 2.direction"),
                         ("0.0,0.1,x,1.0", "row 2")):
-            bad = tmp_path / "bad.csv"
-            bad.write_text(rows[1] + "\n" + line + "\n" if where != "header" else line)
-            run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(bad)],
-                                 capture_output=True, text=True)
-            assert run.returncode == 2 and where in run.stderr, (line, run.stderr)
-            assert len(run.stderr.strip().splitlines()) == 1
+        bad = tmp_path / "bad.csv"
+        bad.write_text(rows[1] + "\n" + line + "\n" if where != "header" else line)
+        run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", frame, str(bad)],
+                             capture_output=True, text=True)
+        assert run.returncode == 2 and where in run.stderr, (line, run.stderr)
+        assert len(run.stderr.strip().splitlines()) == 1
 
 
-def test_gfe_opt_modes_writes_a_frame_csv_that_compares_with_its_model(tmp_path):
-    out = tmp_path / "portal.csv"
+@pytest.mark.parametrize("suffix, error_pct, mac", [
+    # dataset 55 holds a frequency to 6 significant digits (pyuff's field): 1e-5 at most;
+    # the CSV writes every float in full
+    (".uff", 1e-3, 0.99999), (".csv", 1e-9, 1 - 1e-12)])
+def test_gfe_opt_modes_writes_a_frame_test_that_compares_with_its_model(tmp_path, suffix,
+                                                                         error_pct, mac):
+    out = tmp_path / f"portal{suffix}"
     model = str(problem_file("portal-frame.toml"))
     run = subprocess.run([sys.executable, "-m", "gfe_opt", "modes", model, "--out", str(out),
                           "--modes", "5"], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    assert out.read_text().startswith("x,y,direction,")
+    if suffix == ".csv":
+        assert out.read_text().startswith("x,y,direction,")
     run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", model, str(out),
                           "--json"], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     pairs = json.loads(run.stdout)["pairs"]
     assert [(p["test_mode"], p["model_mode"]) for p in pairs] == [(i, i) for i in range(1, 6)]
-    assert all(abs(p["error_pct"]) < 1e-9 and p["mac"] > 1 - 1e-12 for p in pairs)
-
-
-def test_gfe_opt_modes_writes_a_frame_uff_that_compares_with_its_model(tmp_path):
-    out = tmp_path / "portal.uff"
-    model = str(problem_file("portal-frame.toml"))
-    run = subprocess.run([sys.executable, "-m", "gfe_opt", "modes", model, "--out", str(out),
-                          "--modes", "5"], capture_output=True, text=True)
-    assert run.returncode == 0, run.stderr
-    run = subprocess.run([sys.executable, "-m", "gfe_opt", "compare", model, str(out),
-                          "--json"], capture_output=True, text=True)
-    assert run.returncode == 0, run.stderr
-    pairs = json.loads(run.stdout)["pairs"]
-    assert [(p["test_mode"], p["model_mode"]) for p in pairs] == [(i, i) for i in range(1, 6)]
-    # dataset 55 holds a frequency to 6 significant digits (pyuff's field): 1e-5 at most
-    assert all(abs(p["error_pct"]) < 1e-3 and p["mac"] > 0.99999 for p in pairs)
+    assert all(abs(p["error_pct"]) < error_pct and p["mac"] > mac for p in pairs)
 
 
 def test_frame_figures_draw_the_comparison_they_come_from(tmp_path):
@@ -603,16 +601,9 @@ def test_batch_on_a_frame_follows_joints_that_loosen(tmp_path):
     for seed, (name, k) in enumerate(truths.items()):
         model, _, data, _ = _portal_test(k, seed=10 + seed)
         when = f"2026-03-0{3 - seed}T12:00"       # named in the reverse order of time
-        if name.endswith(".json"):
-            (folder / name).write_text(json.dumps({**data, "time": when}))
-        else:
-            rows = [f"# time: {when}", "x,y,direction," + ",".join(
-                repr(m["frequency"]) for m in data["modes"])]
-            for i, sensor in enumerate(data["sensors"]):
-                x, y = _point_of(model, sensor)
-                rows.append(f"{x!r},{y!r},{sensor['direction']}," + ",".join(
-                    repr(m["shape"][i]) for m in data["modes"]))
-            (folder / name).write_text("\n".join(rows) + "\n")
+        (folder / name).write_text(json.dumps({**data, "time": when})
+                                   if name.endswith(".json")
+                                   else _csv_of(model, data, [f"# time: {when}"]))
     data["sensors"][0] = {"node": "Z", "direction": "x"}
     (folder / "t4.json").write_text(json.dumps(data))
     add = ("joint_spring:node=B,member=beam", "joint_spring:node=C,member=beam")
