@@ -90,6 +90,7 @@ from .fitting import (
     misfit,
     noise_of,
     ranked,
+    residuals,
     slots_for,
 )
 from .measured import MeasuredModes, on_model, sensor_matrix
@@ -1184,33 +1185,51 @@ def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
     mirror = _mirror(best, measured, noise, C, sel)
     if mirror is not None:
         notes.append(mirror)
-    places = _other_places(best, measured, sel)
+    places = _other_places(best, measured, noise, C, sel)
     if places is not None:
         notes.append(places)
     notes += equivalent_notes(best, measured)
     return notes
 
 
-def _other_places(fit, measured, sel) -> str | None:
-    """On a frame, a sentence when the added effect fits as well (χ² within
-    :data:`ALIKE_CHI2` noise floors) at another place of the frame (a symmetric portal's
-    other corner): the data cannot tell those places apart."""
+#: two fits whose predictions lie this far apart (Σ of their squared difference over the
+#: noise, in noise floors) are told apart at 95 %: were either true, the χ² difference
+#: between them is normal with mean ±D and standard deviation 2√D, so the wrong one fits
+#: better with probability Φ(−√D/2), 5 % at √D = 2 × 1.645
+SEPARATION = (2 * 1.6448536269514722) ** 2
+
+
+def _other_places(fit, measured, noise, C, sel) -> str | None:
+    """On a frame, a sentence when the added effect fits about as well at another place of
+    the frame (a symmetric portal's other corner): its χ² within :data:`ALIKE_CHI2` noise
+    floors of the best, or the two places' predictions so close (less than
+    :data:`SEPARATION` floors apart) that noise picks the wrong one more than 5 % of the
+    time, whichever fit better here.  The data cannot tell those places apart."""
     if fit.added is None or fit.model.kind != "frame" or not fit.other_places:
         return None
     from .frame_data import effect_place
 
     model = fit.model
     here = effect_place(model, fit.effects[fit.added])
+    mine = residuals(model, measured, noise, C)[0]
     alike = {}
     for effects, chi2 in sorted(fit.other_places, key=lambda item: item[1]):
         place = effect_place(model, effects[fit.added])
-        if chi2 - fit.misfit.chi2 < ALIKE_CHI2 * sel.floor and place != here:
-            alike.setdefault(place, chi2)
+        if place == here or place in alike:
+            continue
+        close = chi2 - fit.misfit.chi2 < ALIKE_CHI2 * sel.floor
+        if not close and mine is not None:
+            theirs = residuals(model.with_effects(list(effects), check=False), measured,
+                               noise, C)[0]
+            close = theirs is not None and float(np.sum((theirs - mine) ** 2)) \
+                < SEPARATION * sel.floor
+        if close:
+            alike[place] = chi2
     if not alike:
         return None
     n = max(fit.misfit.n_residuals, 1)
     what = "frequencies" if measured.frequency_only else "data"
-    return (f"the {fit.name} at {here} fits as well at " + ", ".join(
+    return (f"the {fit.name} at {here} may as well be at " + ", ".join(
         f"{place} (χ²/n {chi2 / n:.3g} against {fit.misfit.chi2_per_residual:.3g})"
         for place, chi2 in alike.items()) + f": the {what} cannot tell these places apart")
 

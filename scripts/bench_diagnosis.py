@@ -173,7 +173,7 @@ def follow(model, measured, noise, result, row):
             adds += 1
             swap = result.replace
             drop = [swap["index"]] if swap else []
-            add = list(result.suggested)
+            add = result.add_arguments()   # the names; on a frame with their places
         elif result.verdict != "effect_found" and result.not_needed:
             # backward elimination: the least needed of the effects the others make
             # unnecessary comes out, the rest re-estimated; then diagnose again
@@ -200,9 +200,10 @@ def follow(model, measured, noise, result, row):
 
 
 def _state(model) -> tuple:
-    """The model's effects by name and place (to the millimetre): a loop that comes back to
-    a state it has been in stops."""
-    return tuple(sorted((e.name, round(float(e.parameters.get("position", -1)), 3))
+    """The model's effects by name and place (to the millimetre; on a frame with their
+    member and node): a loop that comes back to a state it has been in stops."""
+    return tuple(sorted((e.name, round(float(e.parameters.get("position", -1)), 3),
+                         str(e.parameters.get("member", "")), str(e.parameters.get("node", "")))
                         for e in model.effects))
 
 
