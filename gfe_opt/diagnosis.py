@@ -902,7 +902,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         suggested = [ranked[0].name]
     alike = _alike(ranked, sel) if verdict == "effect_found" and swap is None else []
     if verdict == "effect_found":
-        notes += _ambiguities(ranked[0], alike, measured, noise, C, sel)
+        notes += _ambiguities(ranked[0], alike, measured, noise, C, sel,
+                              together if suggested and together is not None else None)
     if measured.frequency_only:
         notes.append(measured.without_shapes_note())
         if realise and model.kind == "beam":
@@ -1172,7 +1173,7 @@ def _alike(ranked, sel) -> list:
             and f.misfit.chi2 - best.misfit.chi2 < ALIKE_CHI2 * sel.floor]
 
 
-def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
+def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[str]:
     """Sentences for what the data cannot decide: effects that fit as well as the best, and
     (frequencies alone) a local effect's mirror image about mid-span."""
     notes = []
@@ -1185,7 +1186,7 @@ def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
     mirror = _mirror(best, measured, noise, C, sel)
     if mirror is not None:
         notes.append(mirror)
-    places = _other_places(best, measured, noise, C, sel)
+    places = _other_places(best, measured, noise, C, sel, together)
     if places is not None:
         notes.append(places)
     notes += equivalent_notes(best, measured)
@@ -1199,23 +1200,27 @@ def _ambiguities(best, alike, measured, noise, C, sel) -> list[str]:
 SEPARATION = (2 * 1.6448536269514722) ** 2
 
 
-def _other_places(fit, measured, noise, C, sel) -> str | None:
+def _other_places(fit, measured, noise, C, sel, together=None) -> str | None:
     """On a frame, a sentence when the added effect fits about as well at another place of
     the frame (a symmetric portal's other corner): its χ² within :data:`ALIKE_CHI2` noise
     floors of the best, or the two places' predictions so close (less than
     :data:`SEPARATION` floors apart) that noise picks the wrong one more than 5 % of the
-    time, whichever fit better here.  The data cannot tell those places apart."""
+    time, whichever fit better here.  The data cannot tell those places apart.  A place
+    that the suggested pair (``together``) holds an effect of this kind at is no
+    alternative: both are suggested (two semi-rigid joints)."""
     if fit.added is None or fit.model.kind != "frame" or not fit.other_places:
         return None
     from .frame_data import effect_place
 
     model = fit.model
     here = effect_place(model, fit.effects[fit.added])
+    taken = {effect_place(model, e) for e in (together.effects if together else ())
+             if e.name == fit.name}
     mine = residuals(model, measured, noise, C)[0]
     alike = {}
     for effects, chi2 in sorted(fit.other_places, key=lambda item: item[1]):
         place = effect_place(model, effects[fit.added])
-        if place == here or place in alike:
+        if place == here or place in alike or place in taken:
             continue
         close = chi2 - fit.misfit.chi2 < ALIKE_CHI2 * sel.floor
         if not close and mine is not None:

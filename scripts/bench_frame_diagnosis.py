@@ -212,7 +212,8 @@ def run_case(case: dict) -> dict:
             else:
                 pos_err.append(100 * abs(hit.parameters["position"] - answer["position"])
                                / answer["length"])
-    undetectable = bool(case["stated"] and first_chi2 < DETECTABLE and not found)
+    undetectable = bool(case["answers"] and case["stated"] and first_chi2 < DETECTABLE
+                        and not found)
     class_right = (all(matched) and not unmatched) or undetectable
     said_ambiguous = bool(ambiguous) and len(ambiguous) + sum(matched) == len(matched) \
         and not unmatched
