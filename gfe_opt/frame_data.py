@@ -147,37 +147,24 @@ CSV_HEADER = ("x", "y", "direction")
 def _read_frame_csv(path, model: FrameModel) -> FrameMeasured:
     """A CSV of a frame test (module docstring): each row's point placed on the frame
     (:func:`locate`), its direction ``x``, ``y`` or degrees from x."""
-    from .measured import csv_rows, csv_stamp, read_text
+    from .measured import csv_data_rows, csv_numbers, csv_stamp, read_text
 
     where = str(path)
     text = read_text(path, "measured")
-    rows = csv_rows([ln for ln in text.splitlines()
-                     if ln.strip() and not ln.lstrip().startswith("#")], where)
+    rows = csv_data_rows(text, where)
     if not rows or [c.strip().lower() for c in rows[0][:3]] != list(CSV_HEADER):
         raise GfeInputError(where, "header", "a frame's CSV starts with the header row "
                             "x,y,direction,<f1 Hz>,<f2 Hz>,... (README \"Plane frames\")")
-    header = rows[0]
-    try:
-        freqs = [float(v) for v in header[3:]]
-    except ValueError:
-        raise GfeInputError(where, "header", "cells after x,y,direction must be frequencies "
-                            f"in Hz, got {header[3:]}") from None
+    freqs, cells = csv_numbers(rows, where, 3, "x,y,direction", text_column=2)
     sensors, shapes = [], []
-    for i, row in enumerate(rows[1:], start=2):
-        if len(row) != len(header):
-            raise GfeInputError(where, f"row {i}", f"has {len(row)} cells, header has "
-                                f"{len(header)}")
-        try:
-            x, y, *values = [float(v) for v in row[:2] + row[3:]]
-        except ValueError:
-            raise GfeInputError(where, f"row {i}", f"non-numeric cell in {row}") from None
+    for i, (x, y, raw, *values) in enumerate(cells, start=2):
         if not (math.isfinite(x) and math.isfinite(y)):
             raise GfeInputError(where, f"row {i}", f"the point ({x:g}, {y:g}) is not finite")
         place = locate(model, x, y)
         if place is None:
             raise GfeInputError(where, f"row {i}", f"at ({x:g}, {y:g}) m it lies on no member "
                                 f"of {model.name}")
-        direction = row[2].strip()
+        direction = raw.strip()
         if direction.lower() in ("x", "y"):
             direction = direction.lower()
         else:
@@ -185,7 +172,7 @@ def _read_frame_csv(path, model: FrameModel) -> FrameMeasured:
                 direction = float(direction)
             except ValueError:
                 raise GfeInputError(where, f"row {i}.direction", "must be x, y or an angle in "
-                                    f"degrees, got {row[2]!r}") from None
+                                    f"degrees, got {raw!r}") from None
         sensors.append({**place, "direction": direction})
         shapes.append(values)
     data = {"modes": [{"frequency": f} for f in freqs], **{

@@ -343,33 +343,44 @@ def csv_rows(lines, where: str) -> list[list[str]]:
                             ) from None
 
 
-def _read_csv(path: Path, dof: str) -> MeasuredModes:
-    where = str(path)
-    lines = [ln for ln in read_text(path, "measured").splitlines()
-             if ln.strip() and not ln.lstrip().startswith("#")]
-    rows = csv_rows(lines, where)
-    if not rows:
-        raise GfeInputError(where, None, "needs a header row of frequencies (and sensor rows)")
+def csv_data_rows(text: str, where: str) -> list[list[str]]:
+    """The rows of a measured CSV, its ``#`` comment lines and blank lines left out."""
+    return csv_rows([ln for ln in text.splitlines()
+                     if ln.strip() and not ln.lstrip().startswith("#")], where)
+
+
+def csv_numbers(rows, where: str, lead: int, lead_text: str, text_column=None):
+    """A measured CSV's frequencies (the header's cells after its ``lead`` label cells) and
+    its sensor rows as numbers (the cell ``text_column`` kept as text): every row as many
+    cells as the header; a bad cell is one line naming the row."""
     header = rows[0]
     try:
-        freqs = [float(v) for v in header[1:]]
+        freqs = [float(v) for v in header[lead:]]
     except ValueError:
-        raise GfeInputError(where, "header", "cells after the first must be frequencies in "
-                            f"Hz, got {header[1:]}") from None
-    x, shapes = [], []
+        raise GfeInputError(where, "header", f"cells after {lead_text} must be frequencies "
+                            f"in Hz, got {header[lead:]}") from None
+    out = []
     for i, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):
             raise GfeInputError(where, f"row {i}", f"has {len(row)} cells, header has "
                                 f"{len(header)}")
         try:
-            vals = [float(v) for v in row]
+            out.append([v if j == text_column else float(v) for j, v in enumerate(row)])
         except ValueError:
             raise GfeInputError(where, f"row {i}", f"non-numeric cell in {row}") from None
-        x.append(vals[0])
-        shapes.append(vals[1:])
-    stamp = csv_stamp(read_text(path, "measured"), where)
+    return freqs, out
+
+
+def _read_csv(path: Path, dof: str) -> MeasuredModes:
+    where = str(path)
+    text = read_text(path, "measured")
+    rows = csv_data_rows(text, where)
+    if not rows:
+        raise GfeInputError(where, None, "needs a header row of frequencies (and sensor rows)")
+    freqs, values = csv_numbers(rows, where, 1, "the first")
+    x, shapes = [v[0] for v in values], [v[1:] for v in values]
     return replace(make_measured(x, dof, freqs, np.array(shapes) if x else None, where),
-                   **stamp)
+                   **csv_stamp(text, where))
 
 
 def csv_stamp(text: str, where: str) -> dict:
