@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from gfe_opt.fitting import FINISH_DECREMENT, TIE, _finish, lowest, ranked
+from gfe_opt.fitting import FINISH_DECREMENT, TIE, _finish, _grid_start, lowest, ranked
 from gfe_opt.modal import peak_rows
 
 T = np.linspace(0.0, 1.0, 12)
@@ -79,6 +79,43 @@ def test_ties_go_to_the_first_in_order():
     assert lowest([3.0, 1.0 + 10 * TIE, 1.0]) == 2             # beyond the tie: the lower
     assert lowest([np.nan, 2.0]) == 1
     assert ranked([2.0, 1.0, 1.0 - 1e-14, 0.5]) == [3, 1, 2, 0]
+
+
+@pytest.mark.parametrize("vanished_wins", [True, False])
+def test_a_vanished_effect_s_grid_points_are_one_start_whatever_rounding_says(vanished_wins):
+    """Where the effect vanishes (size at its null) every place is the same structure; its
+    χ² there differs by the mesh's and BLAS kernel's last bits (1e-8 relative measured),
+    which must not choose the start's place.  The first such point stands for all; when it
+    wins, the grid's best point with the effect present is offered as the informed start.
+    When a present effect wins, it is the start and nothing else is offered."""
+    places = tuple(np.linspace(0.05, 0.95, 19))
+    sizes = (0.0, 0.5, 1.0)                 # 0.0: the null, prepended as _with_null does
+    cost = 0.02 if vanished_wins else 1e-4  # of the effect's size, against a 0.5 gain at 0.7
+
+    def chi2_with(seed):
+        rng = np.random.default_rng(seed)
+        seen = []
+
+        def chi2(z):
+            place, size = z
+            seen.append(tuple(z))
+            if size == 0.0:
+                return 1000.0 * (1.0 + 1e-8 * rng.standard_normal())
+            return 1000.0 + cost * 1000.0 * size - 0.5 * np.exp(-((place - 0.7) / 0.1) ** 2)
+        return chi2, seen
+
+    outcomes = set()
+    for seed in range(8):
+        chi2, seen = chi2_with(seed)
+        start, informed = _grid_start(chi2, [[places, sizes]], [[None, 0.0]])
+        assert sum(1 for z in seen if z[1] == 0.0) == 1      # one vanished point evaluated
+        outcomes.add((tuple(start), None if informed is None else tuple(informed)))
+    assert len(outcomes) == 1
+    (start, informed), = outcomes
+    if vanished_wins:
+        assert start == (0.05, 0.0) and informed == pytest.approx((0.7, 0.5))
+    else:
+        assert start == pytest.approx((0.7, 0.5)) and informed is None
 
 
 def test_mode_sign_follows_the_first_of_equal_peaks():
