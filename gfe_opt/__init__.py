@@ -18,7 +18,7 @@ from .errors import GfeInputError, GfeSolverError  # noqa: F401 (public, light)
 _LAZY = {
     "Comparison": "correlation", "compare": "correlation", "mac": "correlation",
     "Diagnosis": "diagnosis", "UpdateOutcome": "diagnosis", "diagnose": "diagnosis",
-    "update": "diagnosis",
+    "update": "diagnosis", "follow": "diagnosis",
     "EFFECTS": "effects", "EffectType": "effects", "register_effect": "effects",
     "MeasuredModes": "measured", "load_measured": "measured", "save_measured": "measured",
     "Modes": "modal", "model_modes": "modal",

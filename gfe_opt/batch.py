@@ -72,10 +72,13 @@ class Task:
     add: tuple = ()
     freq_noise: float | None = None
     shape_noise: float | None = None
+    loop: bool = False      # diagnose, add what is suggested, again (diagnosis.follow)
 
     @property
     def label(self) -> str:
-        return "update " + " + ".join(self.add) if self.add else "diagnose"
+        if self.add:
+            return "update " + " + ".join(self.add)
+        return "diagnose --loop" if self.loop else "diagnose"
 
     @property
     def model_sha1(self) -> str:
@@ -131,6 +134,18 @@ def _solve(task: Task, model_path: Path, measured_path: Path, name: str) -> dict
                          shape_noise=task.shape_noise)
         fit, before, after = outcome.fit, outcome.before, outcome.after
         out.update(verdict="updated", effect=" + ".join(task.add))
+    elif task.loop:
+        from .diagnosis import follow
+
+        done = follow(model, measured, freq_noise=task.freq_noise,
+                      shape_noise=task.shape_noise)
+        d = done.diagnosis
+        fit = done.fit if done.fit is not None else d.reference
+        before = done.first.current
+        after = fit.misfit if fit is not None else d.current
+        out.update(verdict=d.verdict,
+                   effect=" + ".join(e.name for e in done.found) or None,
+                   verdicts=" -> ".join(done.verdicts))
     else:
         d = diagnose(model, measured, freq_noise=task.freq_noise,
                      shape_noise=task.shape_noise)
@@ -312,8 +327,11 @@ def measured_files(folder) -> list[Path]:
 
 
 def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
-              freq_noise=None, shape_noise=None, force=False, progress=None) -> BatchResult:
-    """Run ``task`` on every measured file of ``folder`` (module docstring)."""
+              freq_noise=None, shape_noise=None, force=False, progress=None,
+              loop=False) -> BatchResult:
+    """Run ``task`` on every measured file of ``folder`` (module docstring); ``loop``: each
+    set's diagnosis is followed as the validation campaigns do (:func:`~gfe_opt.diagnosis.
+    follow`), the row holding the final verdict, the effects the loop added and their fit."""
     from .inputs import check_input_file, read_text
     from .model import load_model
 
@@ -325,13 +343,15 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
         raise GfeInputError("--workers", None, f"must be >= 1, got {workers}")
     check_input_file(Path(model_path), "model")
     model = load_model(model_path, frames=True)  # a bad model is one error, not a row per set
+    if add and loop:
+        raise GfeInputError("--loop", None, "follows a diagnosis; it cannot go with --add")
     if add:
         from .model import parse_effect
 
         for text in add:
             parse_effect(text, model)
     task = Task(str(model_path), read_text(Path(model_path), "model"), tuple(add),
-                freq_noise, shape_noise)
+                freq_noise, shape_noise, loop)
     files = measured_files(folder)
     journal = journal_path(out)
     _check_batch_outputs(out, journal, [Path(model_path), *files])

@@ -140,6 +140,10 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--add", action="append", default=[], metavar="EFFECT",
                    help="update these effects in every set instead of diagnosing "
                         "(repeatable, as for update)")
+    b.add_argument("--loop", action="store_true",
+                   help="follow each diagnosis: add what it suggests and diagnose again "
+                        "until nothing more is found (at most 4 additions; the loop the "
+                        "validation campaigns score); the row holds the final verdict")
     b.add_argument("--scheduler", metavar="tcp://HOST:8786",
                    help="run the sets on this Dask distributed scheduler (default: a local "
                         "pool of processes on this machine)")
@@ -497,7 +501,7 @@ def cmd_batch(args) -> int:
     result = run_batch(args.model, args.measured_dir, args.out, add=args.add,
                        scheduler=args.scheduler, workers=args.workers,
                        freq_noise=args.freq_noise, shape_noise=args.shape_noise,
-                       force=args.force, progress=batch_progress())
+                       force=args.force, progress=batch_progress(), loop=args.loop)
     print(format_batch(result))
     return 1 if result.failed else 0
 

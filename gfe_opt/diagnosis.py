@@ -1597,3 +1597,90 @@ def _profile_start(model, measured, effect, noise):
     if chosen is None:
         raise GfeSolverError(f"the {effect.name} could not be fitted")
     return Effect(effect.name, chosen.parameters)
+
+
+# -------------------------------------------------------------------------------------------
+# The loop a user runs: diagnose, add what is suggested, diagnose again
+# -------------------------------------------------------------------------------------------
+
+#: at most this many additions in :func:`follow` (the validation campaigns' loop)
+FOLLOW_ROUNDS = 4
+
+
+@dataclass
+class Followed:
+    """Result of :func:`follow`: the final model, the fit of its effects (None when
+    nothing was added or taken out), the last diagnosis, and what the loop did: the verdict
+    of each diagnosis in order, the effects added (``add`` arguments, in order), those
+    taken out (``dropped``) and a not-needed one kept because consistency needs it."""
+
+    model: Model
+    fit: Fit | None
+    diagnosis: Diagnosis
+    first: Diagnosis
+    verdicts: list = field(default_factory=list)
+    added: list = field(default_factory=list)
+    dropped: list = field(default_factory=list)
+    kept: str | None = None
+    #: per effect of ``model``: whether the loop added it
+    added_flags: list = field(default_factory=list)
+
+    @property
+    def found(self) -> list:
+        """The final model's effects the loop added (not those it started with)."""
+        return [e for e, new in zip(self.model.effects, self.added_flags) if new]
+
+
+def follow(model: Model, measured: MeasuredModes, first: Diagnosis | None = None, *,
+           freq_noise=None, shape_noise=None, rounds: int = FOLLOW_ROUNDS) -> Followed:
+    """The loop the validation campaigns score (README "Validation campaign"), from the
+    diagnosis ``first`` (made here when None): while the verdict is ``effect_found`` (at
+    most ``rounds`` times), :func:`update` with what it suggests (on a frame at its place;
+    taking out first what it says to ``replace``) and diagnose again; when a diagnosis that
+    finds nothing to add lists present effects as not needed, take out the least needed
+    (smallest χ² rise against what it would need) and diagnose again, unless that turns
+    ``consistent`` into another verdict (then it stays and the loop ends); stop when the
+    model comes back to a set of effects it had before."""
+    noise = {"freq_noise": freq_noise, "shape_noise": shape_noise}
+    result = diagnose(model, measured, **noise) if first is None else first
+    out = Followed(model=model, fit=None, diagnosis=result, first=result,
+                   verdicts=[result.verdict], added_flags=[False] * len(model.effects))
+    adds = 0
+    seen = {_loop_state(model)}
+    while True:
+        if result.verdict == "effect_found" and adds < rounds:
+            adds += 1
+            swap = result.replace
+            drop = [swap["index"]] if swap else []
+            add = result.add_arguments()   # the names; on a frame with their places
+        elif result.verdict != "effect_found" and result.not_needed:
+            least = min(result.not_needed, key=lambda d: d["chi2_rise"] / d["needed"])
+            swap, drop, add = None, [least["index"]], []
+        else:
+            break
+        outcome = update(out.model, measured, add, **noise, drop=drop)
+        if _loop_state(outcome.model) in seen:   # back where the loop was: stop there
+            break
+        again = diagnose(outcome.model, measured, **noise)
+        if not add and result.verdict == "consistent" and again.verdict != "consistent":
+            out.kept = least["effect"]   # needed for consistency, not for significance
+            break
+        out.model, out.fit, out.diagnosis = outcome.model, outcome.fit, again
+        result = again
+        seen.add(_loop_state(out.model))
+        if drop:
+            out.dropped.append(swap["effect"] if swap else least["effect"])
+        # update takes the dropped out and appends the added after the present ones
+        flags = [f for i, f in enumerate(out.added_flags) if i not in drop]
+        out.added_flags = flags + [True] * (len(out.model.effects) - len(flags))
+        out.added += add
+        out.verdicts.append(result.verdict)
+    return out
+
+
+def _loop_state(model) -> tuple:
+    """The model's effects by name and place (to the millimetre; on a frame with their
+    member and node): a loop that comes back to a state it has been in stops."""
+    return tuple(sorted((e.name, round(float(e.parameters.get("position", -1)), 3),
+                         str(e.parameters.get("member", "")), str(e.parameters.get("node", "")))
+                        for e in model.effects))

@@ -50,7 +50,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from gfe_opt.diagnosis import diagnose, update  # noqa: E402
+from gfe_opt.diagnosis import diagnose  # noqa: E402
+from gfe_opt.diagnosis import follow as diagnosis_follow  # noqa: E402
 from gfe_opt.errors import GfeInputError, GfeSolverError  # noqa: E402
 from gfe_opt.measured import make_measured  # noqa: E402
 from gfe_opt.model import model_from_dict  # noqa: E402
@@ -161,50 +162,18 @@ def run_case(case) -> dict:
 
 
 def follow(model, measured, noise, result, row):
-    """The loop a user runs after a first diagnosis ``result`` (module docstring): adds what
-    each diagnosis suggests, takes out what step 9 says is not needed; records verdicts,
+    """The loop a user runs after a first diagnosis ``result`` (module docstring;
+    :func:`gfe_opt.diagnosis.follow`, which ``batch --loop`` runs too); records verdicts,
     additions, what was taken out (``dropped``) or kept (``kept``) in ``row``.  Returns the
     final (model, fit of its effects or None, diagnosis)."""
-    fit = None
-    adds = 0
-    seen = {_state(model)}
-    while True:
-        if result.verdict == "effect_found" and adds < ROUNDS:
-            adds += 1
-            swap = result.replace
-            drop = [swap["index"]] if swap else []
-            add = result.add_arguments()   # the names; on a frame with their places
-        elif result.verdict != "effect_found" and result.not_needed:
-            # backward elimination: the least needed of the effects the others make
-            # unnecessary comes out, the rest re-estimated; then diagnose again
-            least = min(result.not_needed, key=lambda d: d["chi2_rise"] / d["needed"])
-            swap, drop, add = None, [least["index"]], []
-        else:
-            break
-        outcome = update(model, measured, add, **noise, drop=drop)
-        if _state(outcome.model) in seen:   # back where the loop was: stop there
-            break
-        again = diagnose(outcome.model, measured, **noise)
-        if not add and result.verdict == "consistent" and again.verdict != "consistent":
-            # needed for consistency though not for significance: it stays
-            row["kept"] = least["effect"]
-            break
-        model, fit, result = outcome.model, outcome.fit, again
-        seen.add(_state(model))
-        if drop:
-            row.setdefault("dropped", []).append(
-                swap["effect"] if swap else least["effect"])
-        row["added"] += add
-        row["verdicts"].append(result.verdict)
-    return model, fit, result
-
-
-def _state(model) -> tuple:
-    """The model's effects by name and place (to the millimetre; on a frame with their
-    member and node): a loop that comes back to a state it has been in stops."""
-    return tuple(sorted((e.name, round(float(e.parameters.get("position", -1)), 3),
-                         str(e.parameters.get("member", "")), str(e.parameters.get("node", "")))
-                        for e in model.effects))
+    done = diagnosis_follow(model, measured, result, **noise, rounds=ROUNDS)
+    row["verdicts"] += done.verdicts[1:]
+    row["added"] += done.added
+    if done.dropped:
+        row.setdefault("dropped", []).extend(done.dropped)
+    if done.kept is not None:
+        row["kept"] = done.kept
+    return done.model, done.fit, done.diagnosis
 
 
 def _candidates_of(result) -> list:

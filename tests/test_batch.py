@@ -213,3 +213,41 @@ def test_rows_with_nan_and_numpy_numbers_are_written_as_nulls(tmp_path):
         back = read_table(tmp_path / name)[0]
         assert back["freq_error_after_pct"] is None and back["crack.depth_ratio.sigma"] is None
         assert back["crack.depth_ratio"] == 0.25
+
+
+def test_a_looping_batch_ends_each_set_where_the_campaign_loop_does(tmp_path, capsys):
+    """``batch --loop`` follows each diagnosis (add what it suggests, diagnose again): a set
+    with a crack and E off by the temperature ends ``consistent`` with both found, at their
+    truth (the tests' own Hermite beam, not the package's model); a set with neither stays
+    ``consistent`` with nothing added.  One diagnosis a set stops at its first finding."""
+    model = model_from_dict(SMALL, "small")
+    truths = write_campaign(model, tmp_path / "all", 10, n_modes=4, reference_elements=200,
+                            sensors=np.linspace(0.05, 0.525, 9), onset=0.3)
+    (tmp_path / "sets").mkdir()
+    keep = {"set-0001.json": 0, "set-0007.json": 6, "set-0010.json": 9}
+    for name in keep:
+        (tmp_path / "sets" / name).write_bytes((tmp_path / "all" / name).read_bytes())
+    model_path = tmp_path / "model.toml"
+    model_path.write_text(tomli_w.dumps({**SMALL, "name": "small"}))
+    out = tmp_path / "loop.csv"
+    assert main(["batch", str(model_path), str(tmp_path / "sets"), "--out", str(out),
+                 "--loop", "--workers", "2"]) == 0
+    rows = {r["file"]: r for r in read_table(out)}
+    assert {r["task"] for r in rows.values()} == {"diagnose --loop"}
+    quiet = rows["set-0001.json"]
+    assert quiet["verdict"] == "consistent" and quiet["effect"] in (None, "")
+    for name in ("set-0007.json", "set-0010.json"):
+        r = rows[name]
+        depth, factor = truths[keep[name]]
+        assert r["verdict"] == "consistent", r
+        assert r["verdicts"].endswith("consistent") and "->" in r["verdicts"], r
+        assert sorted(r["effect"].split(" + ")) == ["crack", "material"], r
+        assert abs(r["crack.position"] - 0.19) < 0.02 * SMALL["length"], r
+        assert abs(r["crack.depth_ratio"] - depth) < 0.05, (r, depth)
+        assert abs(r["material.E"] / SMALL["material"]["E"] - factor) < 0.004, (r, factor)
+        assert r["chi2_per_residual"] < 2.0
+    # a loop follows diagnoses; it does not go with --add (one line, exit 2)
+    capsys.readouterr()
+    assert main(["batch", str(model_path), str(tmp_path / "sets"), "--out",
+                 str(tmp_path / "x.csv"), "--loop", "--add", "crack"]) == 2
+    assert "--loop" in capsys.readouterr().err
