@@ -1147,9 +1147,9 @@ def _grid_start(chi2, grids, nulls=None):
     """Best point of a coarse grid: each slot's grid (the product of its variables' grids)
     searched with the other slots at their current point.  Of the points where a slot's
     effect vanishes (``nulls``: per slot, per variable, :func:`_null_of`) only the first is
-    evaluated: they are one structure.  Returns the start and, when a vanished effect won
-    the last searched slot, the best point where it does not (else None): the grid's own
-    guess of its place, which a vanished start cannot give."""
+    evaluated: they are one structure.  Returns the start and, when a vanished effect with a
+    place won the last searched slot, the best point where it does not (else None): the
+    grid's own guess of its place, which a vanished start cannot give."""
     current = [np.array([g[0] for g in slot], dtype=float) for slot in grids]
     if not current:
         return np.zeros(0), None
@@ -1170,7 +1170,8 @@ def _grid_start(chi2, grids, nulls=None):
         best = lowest(values)
         current[i] = points[best]
         informed = None
-        if null[best] and not null.all():
+        placed = any(z is None for z in (nulls[i] if nulls else ()))  # a place, a length
+        if null[best] and placed and not null.all():
             rest = [v if not n else np.inf for v, n in zip(values, null)]
             other = [c.copy() for c in current]
             other[i] = points[lowest(rest)]
