@@ -486,6 +486,9 @@ def frame_mesh(model: FrameModel) -> FrameMesh:
                                                                               joints)),
                        grounded=tuple((dof, k) for (dof, _), k in zip(kept.grounded, grounds)))
     mesh = _build_mesh(model)
+    for array in (mesh.xy, mesh.element_member, mesh.element_dofs, mesh.element_length,
+                  mesh.cosines, mesh.constrained):
+        array.flags.writeable = False   # shared by every model of this key
     if len(_MESHES) >= _MESHES_KEPT:
         _MESHES.clear()
     _MESHES[key] = mesh
