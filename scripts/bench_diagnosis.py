@@ -58,7 +58,6 @@ from gfe_opt.model import model_from_dict  # noqa: E402
 from tests import truths  # noqa: E402
 
 POSITION_TOLERANCE = 0.02   # of the length (issue 21)
-ROUNDS = 4
 OUT_OF_FAMILY_VERDICTS = {"consistent", "unexplained"}
 
 
@@ -166,7 +165,7 @@ def follow(model, measured, noise, result, row):
     :func:`gfe_opt.diagnosis.follow`, which ``batch --loop`` runs too); records verdicts,
     additions, what was taken out (``dropped``) or kept (``kept``) in ``row``.  Returns the
     final (model, fit of its effects or None, diagnosis)."""
-    done = diagnosis_follow(model, measured, result, **noise, rounds=ROUNDS)
+    done = diagnosis_follow(model, measured, result, **noise)   # FOLLOW_ROUNDS additions
     row["verdicts"] += done.verdicts[1:]
     row["added"] += done.added
     if done.dropped:
