@@ -589,6 +589,7 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
         f.threshold = sel.threshold(f)
         f.significant = (f.success and not f.failed and f.gain > f.threshold
                          and f.size_sigmas >= SIZE_SIGMAS and not f.unidentified)
+        f.significant_alone = f.significant
         if f.significant and material is not None and f.name != material.name \
                 and not material.failed:
             f.significant = sel.better(f, material)
@@ -1066,17 +1067,26 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
     data (by the information criterion), else None.  When no pair with ``best`` does, the
     other significant candidates that ``best`` does not beat significantly are tried first
     in turn (a short section loss and a crack fit one crack alike; with two cracks only the
-    pair of cracks is determined); once a pair explains, the later of those firsts are tried
+    pair of cracks is determined), and when ``best`` is a uniform change, those it alone
+    kept from being significant; once a pair explains, the later of those firsts are tried
     with its second too (:func:`_simplest_first`)."""
     firsts = [best] + [f for f in _rank([f for f in fits if f.significant and not f.failed],
                                         sel)
                        if f is not best and not sel.better(best, f)
                        and not getattr(effect_type(f.name), "fallback", False)]
+    if effect_type(best.name).uniform_reference:
+        # a uniform change fits best alone: the candidates it alone kept from being
+        # significant are firsts too, after it (two loose joints of a portal read as E 33 %
+        # low, which no second effect completes, where the two joints explain the data)
+        firsts += [f for f in _rank([f for f in fits if f.significant_alone and not f.failed
+                                     and f not in firsts], sel)
+                   if not getattr(effect_type(f.name), "fallback", False)]
     tried = []
     for i, first_fit in enumerate(firsts):
         pair, pairs = _pairs_with(model, measured, noise, first_fit, fits, hint, explains, sel)
         tried += [p for p in pairs if sel.better(p, first_fit)]
         if pair is not None:
+            first_fit.significant = True   # the first of the explaining pair
             return _simplest_first(model, measured, noise, hint, explains, sel, first_fit,
                                    pair, firsts[i + 1:], tried)
     return best, None, tried
@@ -1167,10 +1177,12 @@ def _band(model, measured, noise, result, draws):
 
 def _alike(ranked, sel) -> list:
     """Significant fits other than the best that fit the data as well as it (χ² within
-    :data:`ALIKE_CHI2` noise-floor units): the data cannot tell them apart."""
+    :data:`ALIKE_CHI2` noise-floor units, either way: a pair's first put ahead of a fit
+    far better alone, which no second effect completes, is not like it): the data cannot
+    tell them apart."""
     best = ranked[0]
     return [f for f in ranked[1:] if f.significant and f.name != best.name
-            and f.misfit.chi2 - best.misfit.chi2 < ALIKE_CHI2 * sel.floor]
+            and abs(f.misfit.chi2 - best.misfit.chi2) < ALIKE_CHI2 * sel.floor]
 
 
 def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[str]:

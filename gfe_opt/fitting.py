@@ -343,6 +343,9 @@ class Fit:
     success: bool
     evaluations: int
     significant: bool = False
+    #: significant against the model as it stands, before a uniform change (``material``)
+    #: that fits better alone took it away (set by the diagnosis)
+    significant_alone: bool = False
     failed: bool = False
     size_sigmas: float = 0.0
     gain: float = 0.0          # χ² of the present effects alone minus this fit's

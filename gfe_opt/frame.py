@@ -41,7 +41,7 @@ from .errors import GfeInputError
 
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
-                 "point_mass", "axial_stiffness")
+                 "point_mass", "axial_stiffness", "material")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -95,6 +95,20 @@ class FrameModel:
     @property
     def elements(self) -> int:
         return self.n_elements
+
+    @property
+    def E(self) -> float:
+        """The frame's reference Young's modulus, its first member's (the file's default
+        material unless that member has its own): what a ``material`` effect's E replaces,
+        every member's modulus scaled by the same factor."""
+        return self.members[0].E
+
+    @property
+    def stiffness_factor(self) -> float:
+        """Every member's E over its modelled E: a ``material`` effect's E over :attr:`E`
+        (1 without one)."""
+        return next((float(e.parameters["E"]) / self.E for e in self.effects
+                     if e.name == "material" and "E" in e.parameters), 1.0)
 
     @property
     def raw_effects(self) -> list[dict]:
@@ -288,6 +302,13 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
                             f"yet (known: {', '.join(FRAME_EFFECTS)})")
     if name in ("support_spring", "support_translation"):
         return _support_effect(model, raw, where, prefix)
+    if name == "material":   # every member's E scaled: E is the first member's new one
+        no_unknown(raw, {"effect", "E"}, where, prefix)
+        E = _number(raw, "E", where, positive=True, prefix=prefix)
+        if not 1e7 <= E <= 1e13:
+            raise GfeInputError(where, prefix + "E", f"{E:g} Pa is outside 1e7..1e13 Pa: give "
+                                "E in Pa")
+        return _as_effect({"effect": name, "E": E})
     member_id = _ident(raw, "member", where, prefix)
     if member_id not in {m.id for m in model.members}:
         raise GfeInputError(where, prefix + "member", f"no member {member_id!r}")
@@ -388,7 +409,7 @@ def _as_effect(raw: dict):
 
 def check_repeats(effects, where) -> None:
     """One joint spring a member end, one support effect a node and direction, one axial
-    stiffness a member."""
+    stiffness a member, one material."""
     seen = {}
     for i, e in enumerate(effects):
         key = _effect_key(e)
@@ -403,6 +424,8 @@ def _effect_key(effect) -> tuple | None:
     e = {"effect": effect.name, **effect.parameters}
     if e["effect"] in ("crack", "point_mass"):
         return None
+    if e["effect"] == "material":
+        return ("material",)
     if e["effect"] == "axial_stiffness":
         return ("axial_stiffness", e["member"]) if "member" in e else None
     if "node" not in e:
@@ -552,7 +575,8 @@ def _build_mesh(model: FrameModel) -> FrameMesh:
 def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
     """(n_el, 3): k_ww, k_wθ, k_θθ of each element [N m²] (eq. 11): Euler–Bernoulli, or
     the exact static element of EI(x) where a crack's disturbance reaches."""
-    EI = np.array([model.members[k].E * model.members[k].inertia
+    factor = model.stiffness_factor
+    EI = np.array([factor * model.members[k].E * model.members[k].inertia
                    for k in mesh.element_member])
     out = np.stack([12.0 * EI, 6.0 * EI, 4.0 * EI], axis=1)
     for k, member in enumerate(model.members):
@@ -564,7 +588,7 @@ def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
 
         half = member.depth / 2.0
         decay = half / (2.0 * el.SHEN_PIERRE_GAMMA)
-        ei0 = member.E * member.inertia
+        ei0 = factor * member.E * member.inertia
         L = model.member_length(member) / member.elements
         first = int(np.flatnonzero(mesh.element_member == k)[0])
 
@@ -592,7 +616,8 @@ def axial_rigidity(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
     member (a loose brace)."""
     ratio = {e["member"]: e["ratio"] for e in model.raw_effects
              if e["effect"] == "axial_stiffness"}
-    return np.array([model.members[k].E * model.members[k].area
+    factor = model.stiffness_factor
+    return np.array([factor * model.members[k].E * model.members[k].area
                      * ratio.get(model.members[k].id, 1.0) for k in mesh.element_member])
 
 

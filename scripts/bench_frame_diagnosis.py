@@ -16,7 +16,9 @@ drawn from the seed:
 * ``support``: base A or D turning against a rotational spring (1000 to 20 000 N m/rad);
 * ``crack``: a rotational line spring (another law than the package's crack) on a member
   drawn at random, 15 to 85 % along it, 15 000 to 80 000 N m/rad;
-* ``mass``: 0.02 to 0.15 kg at joint B or C (the beam weighs 0.157 kg).
+* ``mass``: 0.02 to 0.15 kg at joint B or C (the beam weighs 0.157 kg);
+* ``material``: every member's E off by 0.5 to 4 %, either way (the cases of the other
+  classes are drawn from seeds of their own, unchanged by this class's addition).
 
 Noise 1 to 2.5 times 0.3 % shape / 0.05 % frequency, stated (its true level) in half the
 cases.  The loop is the beam campaign's (``bench_diagnosis.follow``): ``diagnose``; while
@@ -27,9 +29,10 @@ least needed first.  Scored as the beam campaign:
 * **class right**: each hidden effect has an added effect of its name at its place (a joint
   spring at its node, whichever member's end; a support spring at its node; a crack on its
   member within 2 % of the member's length; a point mass at its joint, an end of a member
-  meeting there within 2 %) and nothing else was added; on ``none`` anything added is a
-  **false alarm**; the size of a joint, support or mass against its truth (a line-spring
-  crack's is not scored: another law than the package's crack);
+  meeting there within 2 %; a material, anywhere) and nothing else was added; on ``none``
+  anything added is a **false alarm**; the size of a joint, support or mass against its
+  truth, a material's change of E against the true change (a line-spring crack's is not
+  scored: another law than the package's crack);
 * a hidden change whose first χ²/n is below 2 (noise stated) cannot be told from noise: a
   ``consistent`` with nothing added is right too (counted as ``undetectable``);
 * **verdict right**: class right and the last verdict ``consistent`` (``unexplained`` too
@@ -67,7 +70,7 @@ from gfe_opt.problems import portal_frame  # noqa: E402
 from tests.frame_reference import ExactFrame  # noqa: E402
 from tests.test_frame_diagnosis import NOISE, _exact, _guess, _measured, _sensors  # noqa: E402
 
-CLASSES = ("none", "joint", "joints", "support", "crack", "mass")
+CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material")
 POSITION_TOLERANCE = 0.02
 DETECTABLE = 2.0     # first chi2/n at the stated noise below which a change is noise
 
@@ -142,6 +145,14 @@ def make_case(seed: int, group: str) -> dict:
         at = 0.0 if node == beam_m.start else model.member_length(beam_m)
         bracket = [Effect("point_mass", {"member": "beam", "position": at, "mass": mass})]
         answers = [{"name": "point_mass", "node": node, "size": mass}]
+    elif group == "material":
+        # every member's E off by 0.5 to 4 %, either way (wrong material data, temperature)
+        scale = 1.0 + float(rng.choice([-1.0, 1.0])) * float(rng.uniform(0.005, 0.04))
+        exact = _exact(replace(model, members=tuple(replace(m, E=m.E * scale)
+                                                    for m in model.members)))
+        bracket = [Effect("material", {"E": model.E * scale})]
+        # its size: the change of E (a 0.5 % change within 10 % is E within 0.05 %)
+        answers = [{"name": "material", "size": model.E * (scale - 1.0), "base": model.E}]
     else:
         raise ValueError(group)
     factor = float(rng.uniform(1.0, 2.5))
@@ -171,12 +182,12 @@ def _matches(model, effect: Effect, answer: dict) -> bool:
         ends = {member.start: 0.0, member.end: L}
         return answer["node"] in ends and abs(p["position"] - ends[answer["node"]]) \
             <= POSITION_TOLERANCE * L
-    return False
+    return answer["name"] == "material"   # the whole frame: no place
 
 
 def _size(effect: Effect):
     p = effect.parameters
-    return p.get("stiffness", p.get("mass"))
+    return p.get("stiffness", p.get("mass", p.get("E")))
 
 
 def run_case(case: dict) -> dict:
@@ -209,7 +220,8 @@ def run_case(case: dict) -> dict:
         if hit is not None:
             unmatched.remove(hit)
             if answer["name"] != "crack":
-                size_err.append(100 * (_size(hit) / answer["size"] - 1))
+                size_err.append(100 * ((_size(hit) - answer.get("base", 0.0)) / answer["size"]
+                                       - 1))
             else:
                 pos_err.append(100 * abs(hit.parameters["position"] - answer["position"])
                                / answer["length"])
@@ -222,7 +234,8 @@ def run_case(case: dict) -> dict:
     ok_verdicts = ("consistent", "unexplained") if case["group"] == "crack" else ("consistent",)
     return {"name": case["name"], "group": case["group"],
             "noise_factor": round(case["noise_factor"], 3), "stated": case["stated"],
-            "truth": [{k: v for k, v in a.items() if k != "length"} for a in case["answers"]],
+            "truth": [{k: v for k, v in a.items() if k not in ("length", "base")}
+                      for a in case["answers"]],
             "verdicts": verdicts, "added": added,
             "final_effects": [{"name": e.name, **e.parameters} for e in found],
             "first_chi2_per_residual": first_chi2, "undetectable": undetectable,

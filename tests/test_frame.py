@@ -100,6 +100,22 @@ def test_semi_rigid_joints_against_the_exact_solution_and_their_limits():
     assert np.allclose(frame_modes(stiff, 6).frequencies_hz, rigid, rtol=1e-5)
 
 
+def test_a_material_scales_every_member_and_the_frequencies_by_its_root():
+    """``material`` on a frame: every member's E times E / (the first member's E), so K
+    scales and M does not: every frequency times √factor, the shapes unchanged; against
+    the exact solution of the frame with its members' E changed (not the effect)."""
+    base = portal_frame(64)
+    factor = 1.21
+    stiff = base.with_effects([Effect("material", {"E": base.E * factor})])
+    f0, f = frame_modes(base, 6), frame_modes(stiff, 6)
+    assert f.frequencies_hz == pytest.approx(1.1 * f0.frequencies_hz, rel=1e-10)
+    assert np.allclose(f.shapes, f0.shapes, atol=1e-9 * np.abs(f0.shapes).max())
+    exact = exact_of(replace(base, members=tuple(replace(m, E=m.E * factor)
+                                                  for m in base.members)))
+    hz = f.frequencies_hz
+    assert np.max(np.abs(hz / [exact.frequency_near(x, 1e-4) for x in hz] - 1)) < 1e-6
+
+
 def test_a_one_member_frame_is_the_beam_with_its_crack():
     """A vertical column clamped at its base is the package's cantilever beam: the same
     bending frequencies with the same Christides–Barr crack (to 5e-9: the beam integrates
@@ -178,6 +194,10 @@ def test_supports_that_give_against_the_exact_solution_and_their_limits():
                                       "node": "B", "stiffness": 10.0}] * 2}), "effects[1]"),
     (lambda d: d.update({"effects": [{"effect": "axial_stiffness", "member": "beam",
                                       "ratio": 0.5}] * 2}), "effects[1]"),
+    (lambda d: d.update({"effects": [{"effect": "material", "E": 210.0}]}), "effects[0].E"),
+    (lambda d: d.update({"effects": [{"effect": "material", "E": 2e11, "member": "beam"}]}),
+     "effects[0].member"),
+    (lambda d: d.update({"effects": [{"effect": "material", "E": 2e11}] * 2}), "effects[1]"),
 ])
 def test_bad_frame_files_are_one_line_naming_the_key(change, key):
     import tomllib

@@ -126,6 +126,22 @@ def test_two_semirigid_joints_are_found_at_their_joints_and_then_the_portal_agre
     assert again.verdict == "consistent", again.notes
 
 
+@pytest.mark.parametrize("scale,seed", [(1.03, 21), (0.985, 22)])
+def test_a_portal_whose_steel_is_not_as_modelled_is_found_as_its_material(scale, seed):
+    """Every member's E off by +3 % or -1.5 % (the exact solution of the frame with its
+    members' E changed, not the package's effect): ``material`` is the finding, its change
+    of E within 5 % of the truth's, and the model agrees after it."""
+    model = portal_frame()
+    truth = replace(model, members=tuple(replace(m, E=m.E * scale) for m in model.members))
+    measured = _measured(model, _exact(truth), _guess(truth, []), _sensors(model), seed)
+    d = _diagnose(model, measured, **NOISE)
+    assert d.verdict == "effect_found" and d.suggested == ["material"], d.notes
+    assert d.best.parameters["E"] / model.E - 1 == pytest.approx(scale - 1, rel=0.05)
+    after = update(model, measured, ["material"], **NOISE)
+    again = diagnose(after.model, measured, **NOISE)
+    assert again.verdict == "consistent", again.notes
+
+
 def test_two_loose_joints_are_a_pair_not_one_joint_that_may_be_at_the_other():
     """Both beam joints at about 900 N m/rad, 2.4x the noise, not stated (a case of the
     frame campaign): the pair of joint springs is suggested, and the first joint's fit

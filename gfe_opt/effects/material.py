@@ -10,7 +10,7 @@ class Material(EffectType):
     name = "material"
     physics = "uniform Young's modulus (wrong material data, temperature)"
     signature = "a uniform change of the coefficient k of w'''' (bar: of u'') at every node"
-    kinds = ("beam", "bar")
+    kinds = ("beam", "bar", "frame")
     parameters = (Parameter("E", "Pa", "positive", "Young's modulus", null="E"),)
     #: E and a stiffness profile are one parameter: E is held when a profile is fitted
     redundant_with = ("stiffness_profile",)
