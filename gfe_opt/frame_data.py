@@ -537,7 +537,7 @@ def _mark(model: FrameModel, name: str, params: dict):
     """(name, (x, y), label, member polyline or None) of an effect found on a frame: a crack
     or a mass at its place on its member, a joint spring just off its joint along its
     member (which member end turns), a support effect at its node, an axial stiffness along
-    its member, a material at the frame's middle."""
+    its member, a material along every member."""
     def along(member_id, t):
         m = model.member(member_id)
         (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
@@ -572,8 +572,11 @@ def _mark(model: FrameModel, name: str, params: dict):
         point, m = along(params["member"], 0.5)
         line = np.array([model.nodes[m.start], model.nodes[m.end]], dtype=float)
         label = f"{name} of {m.id}: {values}"
-    else:   # the whole frame (a material): marked at the middle of its nodes
-        point = tuple(np.mean(np.array(list(model.nodes.values()), dtype=float), axis=0))
+    else:   # the whole frame (a material): every member drawn, numbered on the first
+        point, _ = along(model.members[0].id, 0.5)
+        line = np.array([p for m in model.members
+                         for p in (model.nodes[m.start], model.nodes[m.end], (np.nan, np.nan))],
+                        dtype=float)   # NaN: one stroke a member
         label = f"{name} of every member: {values}"
     return name, tuple(point), label, line
 

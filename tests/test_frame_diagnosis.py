@@ -136,7 +136,14 @@ def test_a_portal_whose_steel_is_not_as_modelled_is_found_as_its_material(scale,
     measured = _measured(model, _exact(truth), _guess(truth, []), _sensors(model), seed)
     d = _diagnose(model, measured, **NOISE)
     assert d.verdict == "effect_found" and d.suggested == ["material"], d.notes
-    assert d.best.parameters["E"] / model.E - 1 == pytest.approx(scale - 1, rel=0.05)
+    E = d.best.parameters["E"]
+    assert E / model.E - 1 == pytest.approx(scale - 1, rel=0.05)
+    # the figure draws the same result: every member, the fitted E
+    from gfe_opt.report import diagnosis_figures
+
+    frame_axes, listing = diagnosis_figures(d, model)["frame_diagnosis.png"].axes
+    assert [t.get_text() for t in listing.texts] == [
+        f"1: material of every member: E {E:.3g} Pa"]
     after = update(model, measured, ["material"], **NOISE)
     again = diagnose(after.model, measured, **NOISE)
     assert again.verdict == "consistent", again.notes
