@@ -1086,9 +1086,11 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
         pair, pairs = _pairs_with(model, measured, noise, first_fit, fits, hint, explains, sel)
         tried += [p for p in pairs if sel.better(p, first_fit)]
         if pair is not None:
-            first_fit.significant = True   # the first of the explaining pair
-            return _simplest_first(model, measured, noise, hint, explains, sel, first_fit,
-                                   pair, firsts[i + 1:], tried)
+            first, second, tried = _simplest_first(model, measured, noise, hint, explains,
+                                                   sel, first_fit, pair, firsts[i + 1:],
+                                                   tried)
+            first.significant = True   # the first of the explaining pair (of the firsts)
+            return first, second, tried
     return best, None, tried
 
 
