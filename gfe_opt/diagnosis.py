@@ -589,7 +589,11 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
         f.threshold = sel.threshold(f)
         f.significant = (f.success and not f.failed and f.gain > f.threshold
                          and f.size_sigmas >= SIZE_SIGMAS and not f.unidentified)
-        f.significant_alone = f.significant
+        # what it explains alone exceeds its threshold, whatever its size's σ (one loose
+        # joint standing for two is barely determined alone): it may lead a pair when the
+        # uniform change fits best alone (:func:`_lookahead`; the pair is judged itself)
+        f.gains_enough = (f.success and not f.failed and f.gain > f.threshold
+                          and not f.unidentified)
         if f.significant and material is not None and f.name != material.name \
                 and not material.failed:
             f.significant = sel.better(f, material)
@@ -1067,19 +1071,20 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
     data (by the information criterion), else None.  When no pair with ``best`` does, the
     other significant candidates that ``best`` does not beat significantly are tried first
     in turn (a short section loss and a crack fit one crack alike; with two cracks only the
-    pair of cracks is determined), and when ``best`` is a uniform change, those it alone
-    kept from being significant; once a pair explains, the later of those firsts are tried
-    with its second too (:func:`_simplest_first`)."""
+    pair of cracks is determined), and when ``best`` is a uniform change, every candidate
+    whose gain alone exceeds its threshold (its size's σ aside); once a pair explains, the
+    later of those firsts are tried with its second too (:func:`_simplest_first`)."""
     firsts = [best] + [f for f in _rank([f for f in fits if f.significant and not f.failed],
                                         sel)
                        if f is not best and not sel.better(best, f)
                        and not getattr(effect_type(f.name), "fallback", False)]
     if effect_type(best.name).uniform_reference:
-        # a uniform change fits best alone: the candidates it alone kept from being
-        # significant are firsts too, after it (two loose joints of a portal read as E 33 %
-        # low, which no second effect completes, where the two joints explain the data)
-        firsts += [f for f in _rank([f for f in fits if f.significant_alone and not f.failed
-                                     and f not in firsts], sel)
+        # a uniform change fits best alone: every candidate that explains enough alone
+        # leads a pair too, after it (two loose joints of a portal read as E 25-33 % low,
+        # which no second effect completes, where the two joints explain the data; one
+        # joint alone stands for both and is barely determined)
+        firsts += [f for f in _rank([f for f in fits if f.gains_enough and f not in firsts],
+                                    sel)
                    if not getattr(effect_type(f.name), "fallback", False)]
     tried = []
     for i, first_fit in enumerate(firsts):

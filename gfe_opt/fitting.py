@@ -343,9 +343,9 @@ class Fit:
     success: bool
     evaluations: int
     significant: bool = False
-    #: significant against the model as it stands, before a uniform change (``material``)
-    #: that fits better alone took it away (set by the diagnosis)
-    significant_alone: bool = False
+    #: lowers χ² by more than its threshold alone, its size's σ aside: may lead a pair
+    #: when a uniform change fits best alone (set by the diagnosis)
+    gains_enough: bool = False
     failed: bool = False
     size_sigmas: float = 0.0
     gain: float = 0.0          # χ² of the present effects alone minus this fit's
