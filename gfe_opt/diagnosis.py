@@ -1094,7 +1094,8 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
             first, second, tried = _simplest_first(model, measured, noise, hint, explains,
                                                    sel, first_fit, pair, firsts[i + 1:],
                                                    tried)
-            first.significant = True   # the first of the explaining pair (of the firsts)
+            if not first.significant:   # the first of the explaining pair (of the firsts)
+                first.significant = first.leads_pair = True
             return first, second, tried
     return best, None, tried
 

@@ -346,6 +346,8 @@ class Fit:
     #: lowers χ² by more than its threshold alone, its size's σ aside: may lead a pair
     #: when a uniform change fits best alone (set by the diagnosis)
     gains_enough: bool = False
+    #: significant only as the first of a pair that explains the data (set by the diagnosis)
+    leads_pair: bool = False
     failed: bool = False
     size_sigmas: float = 0.0
     gain: float = 0.0          # χ² of the present effects alone minus this fit's

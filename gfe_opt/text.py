@@ -127,7 +127,8 @@ def format_diagnosis(result, model) -> str:
         lines.append(f"{i:>4}  {f.name:<18} {_ratio(f.misfit.chi2_per_residual):>8} "
                      f"{f.misfit.freq_error_rms_pct:8.3f} {_mac(f.misfit.mac_mean, 7, 4)} "
                      f"{_ratio(f.gain):>9} {_ratio(f.threshold):>8} "
-                     f"{min(f.size_sigmas, 999):7.1f}  {'yes' if f.significant else 'no'}")
+                     f"{min(f.size_sigmas, 999):7.1f}  "
+                     f"{'no' if not f.significant else 'in the pair' if f.leads_pair else 'yes'}")
     if result.failed:
         lines.append("failed fits, not ranked: " + "; ".join(
             f"{f.name} ({'; '.join(f.notes)})" for f in result.failed))
