@@ -94,6 +94,10 @@ def test_two_semirigid_joints_are_found_at_their_joints_and_then_the_portal_agre
     d = _diagnose(model, measured)
     assert d.verdict == "effect_found"
     assert d.suggested == ["joint_spring", "joint_spring"]
+    # a uniform E fits better alone than one joint, and no second effect completes it: the
+    # pair of joints is the finding, its first significant as the pair's
+    material = next(f for f in d.fits if f.name == "material")
+    assert material.misfit.chi2 < d.fits[0].misfit.chi2 and d.fits[0].significant
     found = {e.parameters["node"]: e.parameters["stiffness"] for e in d.together.effects}
     assert set(found) == {"B", "C"}   # at a two-member joint either member's end is one place
     # the pair holds both joints: neither is the other's alternative place (it was said)
