@@ -587,13 +587,12 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
             # |value − null|/σ is for a linear model)
             f.size_sigmas = float(np.sqrt(max(f.gain, 0.0) / sel.floor))
         f.threshold = sel.threshold(f)
-        f.significant = (f.success and not f.failed and f.gain > f.threshold
-                         and f.size_sigmas >= SIZE_SIGMAS and not f.unidentified)
         # what it explains alone exceeds its threshold, whatever its size's σ (one loose
         # joint standing for two is barely determined alone): it may lead a pair when the
         # uniform change fits best alone (:func:`_lookahead`; the pair is judged itself)
         f.gains_enough = (f.success and not f.failed and f.gain > f.threshold
                           and not f.unidentified)
+        f.significant = f.gains_enough and f.size_sigmas >= SIZE_SIGMAS
         if f.significant and material is not None and f.name != material.name \
                 and not material.failed:
             f.significant = sel.better(f, material)
@@ -1083,8 +1082,8 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
         # leads a pair too, after it (two loose joints of a portal read as E 25-33 % low,
         # which no second effect completes, where the two joints explain the data; one
         # joint alone stands for both and is barely determined)
-        firsts += [f for f in _rank([f for f in fits if f.gains_enough and f not in firsts],
-                                    sel)
+        firsts += [f for f in _rank([f for f in fits if f.gains_enough
+                                     and not any(f is g for g in firsts)], sel)
                    if not getattr(effect_type(f.name), "fallback", False)]
     tried = []
     for i, first_fit in enumerate(firsts):

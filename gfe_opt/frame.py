@@ -304,10 +304,10 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
         return _support_effect(model, raw, where, prefix)
     if name == "material":   # every member's E scaled: E is the first member's new one
         no_unknown(raw, {"effect", "E"}, where, prefix)
+        from .effects import effect_type
+
         E = _number(raw, "E", where, positive=True, prefix=prefix)
-        if not 1e7 <= E <= 1e13:
-            raise GfeInputError(where, prefix + "E", f"{E:g} Pa is outside 1e7..1e13 Pa: give "
-                                "E in Pa")
+        effect_type(name).check(model, {"E": E}, where, prefix)   # the beams' range, one rule
         return _as_effect({"effect": name, "E": E})
     member_id = _ident(raw, "member", where, prefix)
     if member_id not in {m.id for m in model.members}:
