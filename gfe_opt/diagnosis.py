@@ -811,6 +811,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     notes += [f"{f.name} is not estimable from these data: " + "; ".join(f.unidentified)
               for f in fits if not f.failed and f.unidentified and f.gain > f.threshold
               and f.size_sigmas >= SIZE_SIGMAS]
+    notes += [traded_note(f) for f in fits if not f.failed and f.traded and f.significant]
     ranked = _rank([f for f in fits if not f.failed and f.significant], sel) + _rank(
         [f for f in fits if not f.failed and not f.significant], sel)
     if together is not None and ranked[0].name != suggested[0]:
@@ -1555,7 +1556,15 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
                          added=list(range(len(model.effects), len(fit.effects))),
                          notes=[*taken, *dropped, *equivalent_notes(fit, measured),
                                 *(["not estimable from these data: " + u
-                                   for u in fit.unidentified])])
+                                   for u in fit.unidentified]),
+                                *([traded_note(fit)] if fit.traded else [])])
+
+
+def traded_note(fit) -> str:
+    """What a fit whose parameters trade as its effect allows (:attr:`Fit.traded`) tells."""
+    return (f"{fit.name}: " + "; ".join(fit.traded) + ": the data fix their combination (a "
+            "zone's added compliance ℓ (1/r − 1) and mass ℓ (m − 1)), not each; their ± "
+            "understate that trade")
 
 
 def drop_indices(model: Model, drop) -> set:

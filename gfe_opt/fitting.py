@@ -359,6 +359,9 @@ class Fit:
     #: diagnosis; a place that fits as well is said)
     other_places: list = field(default_factory=list)
     unidentified: list = field(default_factory=list)  # parameters these data do not estimate
+    #: trades the effect declares a finding (a short zone: its length against its ratios;
+    #: the combination is told, each σ understates its own range): sentences
+    traded: list = field(default_factory=list)
     #: per effect, parameters that ended on a bound of their range: {key: "at least" |
     #: "at most"} (the data tell one side only)
     bounds: tuple = ()
@@ -406,7 +409,8 @@ class Fit:
                 "significant": self.significant, "mirror_position": self.mirror_position,
                 "equivalent": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
                                 for e in effects] for effects in self.equivalent],
-                "not_estimable": list(self.unidentified), "bounds": added["bounds"]}
+                "not_estimable": list(self.unidentified), "traded": list(self.traded),
+                "bounds": added["bounds"]}
 
 
 def jsonable(params: dict) -> dict:
@@ -639,15 +643,15 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     fitted = base.with_effects(effects, check=False)
     fit_misfit = misfit(fitted, measured, noise, C)
     saturated = _saturated(slots, z, lower, upper)
-    sigma, unidentified = _uncertainty(residual, z, slots, base, fit_misfit, lower, upper,
-                                       saturated)
+    sigma, unidentified, traded = _uncertainty(residual, z, slots, base, fit_misfit, lower,
+                                               upper, saturated)
     added = [i for i, s in enumerate(slots) if s.added]
     return Fit(name=name or (slots[added[0]].effect.name if added else "baseline"),
                effects=tuple(effects), sigma=tuple(sigma), added=added[0] if added else None,
                model=fitted, misfit=fit_misfit, n_params=z.size, status=status,
                success=success and np.isfinite(fit_misfit.chi2), evaluations=residual.count,
                equivalent=[tuple(effects_of(e)) for e in equivalent],
-               unidentified=unidentified, bounds=tuple(saturated))
+               unidentified=unidentified, traded=traded, bounds=tuple(saturated))
 
 
 #: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
@@ -973,7 +977,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     n = z.size
     out = [{} for _ in slots]
     if n == 0 or not np.isfinite(fit_misfit.chi2):
-        return out, []
+        return out, [], []
     held = np.array([v.key in marks for marks, slot in zip(saturated or [{}] * len(slots),
                                                              slots) for v in slot.variables],
                     dtype=bool)
@@ -1054,13 +1058,30 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
                 rises.append(float(rr @ rr) - chi0)
         return not rises or min(rises) < s2
 
+    def told(a, b) -> bool:
+        """Two parameters of one effect whose trade the effect declares a finding
+        (:meth:`~gfe_opt.effects.base.EffectType.told_trades`: a short zone's length and
+        ratios, of which the data fix the combination)."""
+        if owner[a] != owner[b]:
+            return False
+        keys = {TIE_KEYS.get(k, k) for k in (names[a].split(".", 1)[1],
+                                             names[b].split(".", 1)[1])}
+        return keys in slots[owner[a]].effect.told_trades(base)
+
+    traded = []
     for a in range(m):
         for b in range(a + 1, m):
             if (a in added or b in added) and np.isfinite(corr[a, b]) \
                     and abs(corr[a, b]) > IDENTIFIABLE_CORRELATION and trades(a, b):
-                unidentified.append(f"{names[a]} and {names[b]} trade against each other "
-                                    f"(correlation {corr[a, b]:+.3f})")
-    return out, unidentified
+                (traded if told(a, b) else unidentified).append(
+                    f"{names[a]} and {names[b]} trade against each other (correlation "
+                    f"{corr[a, b]:+.3f})")
+    return out, unidentified, traded
+
+
+#: the parameter a tied direction moves (:meth:`EffectType.tie`: a zone's inner edge, its
+#: length)
+TIE_KEYS = {"inner edge": "length"}
 
 
 def _ties(slots, base, z):

@@ -41,7 +41,7 @@ from .errors import GfeInputError
 
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
-                 "point_mass", "axial_stiffness", "material")
+                 "point_mass", "axial_stiffness", "material", "section_loss")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -322,6 +322,8 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
             raise GfeInputError(where, prefix + "ratio", f"must lie in (0, 10] (EA of the "
                                 f"member over the modelled), got {ratio:g}")
         return _as_effect({"effect": name, "member": member_id, "ratio": ratio})
+    if name == "section_loss":
+        return _section_loss(model, member, raw, where, prefix)
     if name == "crack":
         no_unknown(raw, {"effect", "member", "position", "depth_ratio"}, where, prefix)
         length = model.member_length(member)
@@ -345,6 +347,34 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
                             f"node {node!r} (its ends: {member.start}, {member.end})")
     k = _number(raw, "stiffness", where, positive=True, prefix=prefix)
     return _as_effect({"effect": name, "member": member_id, "node": node, "stiffness": k})
+
+
+def _section_loss(model: FrameModel, member: Member, raw: dict, where: str, prefix: str):
+    """A zone of a member, ``position`` (its centre, m from the member's start) ± ``length``
+    / 2, that lies on the member (it may reach a joint), with its EI and ρA ratios."""
+    from .effects import effect_type
+    from .effects.base import no_unknown
+    from .model import _number
+
+    keys = ("position", "length", "stiffness_ratio", "mass_ratio")
+    no_unknown(raw, {"effect", "member", *keys}, where, prefix)
+    span = model.member_length(member)
+    c = _number(raw, "position", where, prefix=prefix)
+    ell = _number(raw, "length", where, positive=True, prefix=prefix)
+    if ell > span * (1 + 1e-12):
+        raise GfeInputError(where, prefix + "length", f"{ell:g} m is longer than member "
+                            f"{member.id!r} ({span:g} m)")
+    # a fitted zone is cut to the member (to_physical), its edges there to rounding
+    if c - ell / 2 < -1e-9 * span or c + ell / 2 > span * (1 + 1e-9):
+        raise GfeInputError(where, prefix + "position", f"the zone {c - ell / 2:g} to "
+                            f"{c + ell / 2:g} m must lie on member {member.id!r} (0 to "
+                            f"{span:g} m)")
+    kind = effect_type("section_loss")
+    out = {"effect": "section_loss", "member": member.id, "position": c, "length": ell}
+    for key in keys[2:]:   # the beams' ranges, one rule
+        out[key] = kind.parameter(key).check(_number(raw, key, where, prefix=prefix), model,
+                                             where, prefix + key)
+    return _as_effect(out)
 
 
 def _point_mass(model: FrameModel, member: Member, raw: dict, where: str, prefix: str):
@@ -422,7 +452,7 @@ def check_repeats(effects, where) -> None:
 def _effect_key(effect) -> tuple | None:
     """What two instances of a frame effect may not share (a crack may repeat)."""
     e = {"effect": effect.name, **effect.parameters}
-    if e["effect"] in ("crack", "point_mass"):
+    if e["effect"] in ("crack", "point_mass", "section_loss"):
         return None
     if e["effect"] == "material":
         return ("material",)
@@ -572,9 +602,37 @@ def _build_mesh(model: FrameModel) -> FrameMesh:
                      constrained=np.array(sorted(fixed), dtype=int))
 
 
+def _zones(model: FrameModel, member_id: str) -> list[tuple[float, float, float, float]]:
+    """(start, end, stiffness_ratio, mass_ratio) of each ``section_loss`` zone on a member
+    (m from its start node)."""
+    return [(e["position"] - e["length"] / 2.0, e["position"] + e["length"] / 2.0,
+             e["stiffness_ratio"], e["mass_ratio"]) for e in model.raw_effects
+            if e["effect"] == "section_loss" and e["member"] == member_id]
+
+
+def _zone_factor(zones, which: int):
+    """The product of the zones' ratios (``which``: 2 stiffness, 3 mass) at x, 1 outside."""
+    def q(x):
+        out = np.ones_like(np.asarray(x, dtype=float))
+        for zone in zones:
+            out = out * np.where((x >= zone[0]) & (x <= zone[1]), zone[which], 1.0)
+        return out
+
+    return q
+
+
+def _zoned_elements(zones, step: float, count: int) -> list[int]:
+    """The elements of a member (each ``step`` long) that a zone covers, even in part."""
+    out = set()
+    for a, b, *_ in zones:
+        out.update(range(max(int(a // step), 0), min(int(math.ceil(b / step)), count)))
+    return sorted(out)
+
+
 def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
     """(n_el, 3): k_ww, k_wθ, k_θθ of each element [N m²] (eq. 11): Euler–Bernoulli, or
-    the exact static element of EI(x) where a crack's disturbance reaches."""
+    the exact static element of EI(x) where a crack's disturbance or a section loss's zone
+    (EI × its stiffness ratio) reaches."""
     factor = model.stiffness_factor
     EI = np.array([factor * model.members[k].E * model.members[k].inertia
                    for k in mesh.element_member])
@@ -582,30 +640,33 @@ def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
     for k, member in enumerate(model.members):
         cracks = [(e["position"], e["depth_ratio"]) for e in model.raw_effects
                   if e["effect"] == "crack" and e["member"] == member.id]
-        if not cracks:
+        zones = _zones(model, member.id)
+        if not cracks and not zones:
             continue
         from .effects.crack import CRACK_REACH
 
-        half = member.depth / 2.0
-        decay = half / (2.0 * el.SHEN_PIERRE_GAMMA)
+        half = None if member.depth is None else member.depth / 2.0
+        decay = None if not cracks else half / (2.0 * el.SHEN_PIERRE_GAMMA)
         ei0 = factor * member.E * member.inertia
         L = model.member_length(member) / member.elements
         first = int(np.flatnonzero(mesh.element_member == k)[0])
+        zoned = _zone_factor(zones, 2)
 
-        def rigidity(x, cracks=cracks, half=half, ei0=ei0):
-            q = np.ones_like(np.asarray(x, dtype=float))
+        def rigidity(x, cracks=cracks, half=half, ei0=ei0, zoned=zoned):
+            q = zoned(x)
             for x_c, ratio in cracks:
                 q = q * el.christides_barr_q(x, x_c, ratio, half)
             return ei0 * q
 
-        reached = set()
+        reached = set(_zoned_elements(zones, L, member.elements))
         for x_c, _ in cracks:
             lo = max(int((x_c - CRACK_REACH * decay) // L), 0)
             hi = min(int((x_c + CRACK_REACH * decay) // L) + 1, member.elements)
             reached.update(range(lo, hi))
         for j in sorted(reached):
             x0 = j * L
-            inside = tuple(x_c for x_c, _ in cracks if x0 < x_c < x0 + L)
+            inside = (*(x_c for x_c, _ in cracks if x0 < x_c < x0 + L),
+                      *_edges(zones, x0, L))
             out[first + j] = el.beam_stiffness_from_flexibility(
                 rigidity, x0, L, breakpoints=inside, refine_scale=decay)
     return out
@@ -613,12 +674,54 @@ def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
 
 def axial_rigidity(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
     """EA of each element [N], times the ``ratio`` of an ``axial_stiffness`` effect on its
-    member (a loose brace)."""
+    member (a loose brace); where a section loss's zone covers an element, that of the
+    element's exact axial flexibility ∫ dx / EA(x) (EA × the zone's mass ratio: the zone's
+    area changes as its mass, the material stays)."""
     ratio = {e["member"]: e["ratio"] for e in model.raw_effects
              if e["effect"] == "axial_stiffness"}
     factor = model.stiffness_factor
-    return np.array([factor * model.members[k].E * model.members[k].area
-                     * ratio.get(model.members[k].id, 1.0) for k in mesh.element_member])
+    out = np.array([factor * model.members[k].E * model.members[k].area
+                    * ratio.get(model.members[k].id, 1.0) for k in mesh.element_member])
+    for k, member in enumerate(model.members):
+        zones = _zones(model, member.id)
+        if not zones:
+            continue
+        L = model.member_length(member) / member.elements
+        first = int(np.flatnonzero(mesh.element_member == k)[0])
+        area = _zone_factor(zones, 3)
+        for j in _zoned_elements(zones, L, member.elements):
+            x, w = el.element_quadrature(j * L, (j + 1) * L, _edges(zones, j * L, L))
+            out[first + j] *= L / np.sum(w / area(x))
+    return out
+
+
+def _edges(zones, x0: float, L: float) -> tuple:
+    """The zones' edges strictly inside [x0, x0 + L]."""
+    return tuple(edge for z in zones for edge in z[:2] if x0 < edge < x0 + L)
+
+
+def _zone_masses(model: FrameModel, mesh: FrameMesh, rhoA) -> dict:
+    """{element: (6, 6) local mass added by the section-loss zones over it}: ρA (mass ratio
+    − 1) ∫ NᵀN over the part covered (bar and beam shape functions, exact quadrature)."""
+    out = {}
+    for k, member in enumerate(model.members):
+        zones = _zones(model, member.id)
+        if not zones:
+            continue
+        L = model.member_length(member) / member.elements
+        first = int(np.flatnonzero(mesh.element_member == k)[0])
+        change = _zone_factor(zones, 3)
+        scaling = el.beam_dof_scaling(np.array([L]))[0]
+        for j in _zoned_elements(zones, L, member.elements):
+            x, w = el.element_quadrature(j * L, (j + 1) * L, _edges(zones, j * L, L))
+            c = rhoA[first + j] * w * (change(x) - 1.0)
+            s = (x - j * L) / L
+            added = np.zeros((6, 6))
+            bar, beam = el.linear(s), el.hermite(s) * scaling
+            added[np.ix_([0, 3], [0, 3])] = bar.T @ (c[:, None] * bar)
+            added[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = beam.T @ (c[:, None] * beam)
+            out[first + j] = added
+    return out
 
 
 def element_matrices(model: FrameModel, mesh: FrameMesh):
@@ -644,6 +747,8 @@ def element_matrices(model: FrameModel, mesh: FrameMesh):
     mass = (rhoA * L)[:, None, None] * el.symmetric_beam_mass(
         **{k: np.full(n, v) for k, v in el.CONSISTENT_BEAM_MASS.items()})
     local_m[np.ix_(range(n), bend, bend)] = mass * scaling[:, :, None] * scaling[:, None, :]
+    for e, added in _zone_masses(model, mesh, rhoA).items():
+        local_m[e] += added
     T = rotations(mesh.cosines)
     Tt = np.swapaxes(T, 1, 2)
     return Tt @ local_k @ T, Tt @ local_m @ T

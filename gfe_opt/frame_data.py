@@ -521,6 +521,9 @@ def effect_place(model: FrameModel, effect) -> str:
     p = effect.parameters
     if effect.name == "joint_spring":
         return f"node {p['node']} ({p['member']}'s end)"
+    if "length" in p and "member" in p:   # a zone: its extent along its member
+        a, b = p["position"] - p["length"] / 2, p["position"] + p["length"] / 2
+        return f"{p['member']} from {a:.3g} to {b:.3g} m"
     if "position" in p and "member" in p:
         m = model.member(p["member"])
         length = model.member_length(m)
@@ -537,7 +540,7 @@ def _mark(model: FrameModel, name: str, params: dict):
     """(name, (x, y), label, member polyline or None) of an effect found on a frame: a crack
     or a mass at its place on its member, a joint spring just off its joint along its
     member (which member end turns), a support effect at its node, an axial stiffness along
-    its member, a material along every member."""
+    its member, a material along every member, a section loss over its zone."""
     def along(member_id, t):
         m = model.member(member_id)
         (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
@@ -554,7 +557,14 @@ def _mark(model: FrameModel, name: str, params: dict):
     values = ", ".join(f"{k} {v:.3g}{unit(k)}" for k, v in params.items()
                        if k != "position" and isinstance(v, (int, float)))
     line = None
-    if "position" in params:
+    if "length" in params:   # a zone: drawn over its extent on its member
+        m = model.member(params["member"])
+        span = model.member_length(m)
+        ends = [along(m.id, (params["position"] + side * params["length"] / 2) / span)[0]
+                for side in (-1, 1)]
+        point, line = along(m.id, params["position"] / span)[0], np.array(ends, dtype=float)
+        label = f"{name} on {m.id} at {params['position']:.3g} m: {values}"
+    elif "position" in params:
         m = model.member(params["member"])
         point, _ = along(m.id, params["position"] / model.member_length(m))
         label = f"{name} on {m.id} at {params['position']:.3g} m: {values}"

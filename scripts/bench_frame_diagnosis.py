@@ -17,8 +17,13 @@ drawn from the seed:
 * ``crack``: a rotational line spring (another law than the package's crack) on a member
   drawn at random, 15 to 85 % along it, 15 000 to 80 000 N m/rad;
 * ``mass``: 0.02 to 0.15 kg at joint B or C (the beam weighs 0.157 kg);
-* ``material``: every member's E off by 0.5 to 4 %, either way (the cases of the other
-  classes are drawn from seeds of their own, unchanged by this class's addition).
+* ``material``: every member's E off by 0.5 to 4 %, either way;
+* ``zone``: a member drawn at random with a zone 5 to 25 % of its length, anywhere on it
+  (a joint or base included), whose section is 0.5 to 0.8 or 1.25 to 2.5 times as stiff
+  in bending (a thinned or a doubled section: its depth changed, so its area and mass by
+  the cube root of that): the exact solution of the member split at the zone's edges,
+  the middle part's I and A scaled (the cases of the other classes are drawn from seeds
+  of their own, unchanged by the additions of ``material`` and ``zone``).
 
 Noise 1 to 2.5 times 0.3 % shape / 0.05 % frequency, stated (its true level) in half the
 cases.  The loop is the beam campaign's (``bench_diagnosis.follow``): ``diagnose``; while
@@ -29,10 +34,12 @@ least needed first.  Scored as the beam campaign:
 * **class right**: each hidden effect has an added effect of its name at its place (a joint
   spring at its node, whichever member's end; a support spring at its node; a crack on its
   member within 2 % of the member's length; a point mass at its joint, an end of a member
-  meeting there within 2 %; a material, anywhere) and nothing else was added; on ``none``
+  meeting there within 2 %; a material, anywhere; a section loss on the zone's member with
+  its centre within 2 % of the member's length) and nothing else was added; on ``none``
   anything added is a **false alarm**; the size of a joint, support or mass against its
-  truth, a material's change of E against the true change (a line-spring crack's is not
-  scored: another law than the package's crack);
+  truth, a material's change of E against the true change, a zone's added bending
+  compliance ∫(1/EI − 1/EI₀) dx = ℓ (1/r − 1)/EI₀ against the truth's (a line-spring
+  crack's is not scored: another law than the package's crack);
 * a hidden change whose first χ²/n is below 2 (noise stated) cannot be told from noise: a
   ``consistent`` with nothing added is right too (counted as ``undetectable``);
 * **verdict right**: class right and the last verdict ``consistent`` (``unexplained`` too
@@ -67,10 +74,10 @@ from gfe_opt.diagnosis import diagnose  # noqa: E402
 from gfe_opt.frame import frame_modes  # noqa: E402
 from gfe_opt.model import Effect  # noqa: E402
 from gfe_opt.problems import portal_frame  # noqa: E402
-from tests.frame_reference import ExactFrame  # noqa: E402
+from tests.frame_reference import ExactFrame, zone_frame  # noqa: E402
 from tests.test_frame_diagnosis import NOISE, _exact, _guess, _measured, _sensors  # noqa: E402
 
-CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material")
+CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material", "zone")
 POSITION_TOLERANCE = 0.02
 DETECTABLE = 2.0     # first chi2/n at the stated noise below which a change is noise
 
@@ -153,6 +160,8 @@ def make_case(seed: int, group: str) -> dict:
         bracket = [Effect("material", {"E": model.E * scale})]
         # its size: the change of E (a 0.5 % change within 10 % is E within 0.05 %)
         answers = [{"name": "material", "size": model.E * (scale - 1.0), "base": model.E}]
+    elif group == "zone":
+        exact, where, answers, bracket = _zone(model, rng)
     else:
         raise ValueError(group)
     factor = float(rng.uniform(1.0, 2.5))
@@ -167,13 +176,35 @@ def make_case(seed: int, group: str) -> dict:
             "noise": noise if stated else {}}
 
 
+def _zone(model, rng):
+    """A zone of a random member with its bending stiffness scaled (its depth changed: I by
+    r, A and ρA by r^(1/3)), exact: the member split at the zone's edges."""
+    member = model.members[int(rng.integers(len(model.members)))]
+    L = model.member_length(member)
+    ell = float(rng.uniform(0.05, 0.25)) * L
+    a = float(rng.uniform(0.0, L - ell))
+    if rng.random() < 0.25:   # at a joint or a base: a haunch, a corroded foot
+        a = 0.0 if rng.random() < 0.5 else L - ell
+    b = a + ell
+    r = _log_uniform(rng, 0.5, 0.8) if rng.random() < 0.5 else _log_uniform(rng, 1.25, 2.5)
+    area = r ** (1.0 / 3.0)
+    exact, where = zone_frame(model, member.id, a, b, r, area)
+    bracket = [Effect("section_loss", {"member": member.id, "position": (a + b) / 2,
+                                       "length": ell, "stiffness_ratio": r,
+                                       "mass_ratio": area})]
+    EI = member.E * member.inertia
+    answers = [{"name": "section_loss", "member": member.id, "position": (a + b) / 2,
+                "length": L, "extent": ell, "ratio": r, "size": ell * (1 / r - 1) / EI}]
+    return exact, where, answers, bracket
+
+
 def _matches(model, effect: Effect, answer: dict) -> bool:
     p = effect.parameters
     if effect.name != answer["name"]:
         return False
     if answer["name"] in ("joint_spring", "support_spring"):
         return p.get("node") == answer["node"]
-    if answer["name"] == "crack":
+    if answer["name"] in ("crack", "section_loss"):
         return p.get("member") == answer["member"] and abs(
             p["position"] - answer["position"]) <= POSITION_TOLERANCE * answer["length"]
     if answer["name"] == "point_mass":
@@ -185,8 +216,11 @@ def _matches(model, effect: Effect, answer: dict) -> bool:
     return answer["name"] == "material"   # the whole frame: no place
 
 
-def _size(effect: Effect):
+def _size(model, effect: Effect):
     p = effect.parameters
+    if effect.name == "section_loss":   # the added bending compliance (rad / (N m))
+        m = model.member(p["member"])
+        return p["length"] * (1 / p["stiffness_ratio"] - 1) / (m.E * m.inertia)
     return p.get("stiffness", p.get("mass", p.get("E")))
 
 
@@ -220,9 +254,9 @@ def run_case(case: dict) -> dict:
         if hit is not None:
             unmatched.remove(hit)
             if answer["name"] != "crack":
-                size_err.append(100 * ((_size(hit) - answer.get("base", 0.0)) / answer["size"]
-                                       - 1))
-            else:
+                size_err.append(100 * ((_size(case["model"], hit) - answer.get("base", 0.0))
+                                       / answer["size"] - 1))
+            if answer["name"] in ("crack", "section_loss"):
                 pos_err.append(100 * abs(hit.parameters["position"] - answer["position"])
                                / answer["length"])
     undetectable = bool(case["answers"] and case["stated"] and first_chi2 < DETECTABLE

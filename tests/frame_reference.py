@@ -186,3 +186,41 @@ def _basis(beta, t, order):
     if order == 0:
         return np.array(f)
     return beta * np.array([-f[1], f[0], f[3], f[2]])
+
+
+def zone_frame(model, member_id, a, b, stiffness_ratio, area_ratio):
+    """The exact frame of ``model`` (a :class:`~gfe_opt.frame.FrameModel`, read for its
+    geometry and sections only) with member ``member_id`` split at a and b (m from its start;
+    either may be an end) and the part between them of I × ``stiffness_ratio`` and A ×
+    ``area_ratio`` (EA and ρA with it), and ``where``, which maps a sensor of the model to
+    the split frame's (its parts are named ``<member>-0``, ``-1`` ...)."""
+    member = next(m for m in model.members if m.id == member_id)
+    (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
+    L = math.hypot(x1 - x0, y1 - y0)
+    nodes, members, names = dict(model.nodes), [], []
+    cuts = [(0.0, member.start)]
+    for t, name in ((a, "Z1"), (b, "Z2")):
+        if 0.0 < t < L:
+            nodes[name] = (x0 + t / L * (x1 - x0), y0 + t / L * (y1 - y0))
+            cuts.append((t, name))
+    cuts.append((L, member.end))
+    for m in model.members:
+        if m.id != member_id:
+            members.append((m.start, m.end, m.E, m.rho, m.area, m.inertia))
+            names.append(m.id)
+            continue
+        for i, ((t0, n0), (t1, n1)) in enumerate(zip(cuts[:-1], cuts[1:])):
+            inside = a <= t0 and t1 <= b
+            members.append((n0, n1, m.E, m.rho, m.area * (area_ratio if inside else 1.0),
+                            m.inertia * (stiffness_ratio if inside else 1.0)))
+            names.append(f"{m.id}-{i}")
+    starts = [t for t, _ in cuts[:-1]]
+
+    def where(sensor):
+        if sensor.get("member") != member_id:
+            return sensor
+        i = max(k for k, t in enumerate(starts) if t <= sensor["position"])
+        return {**sensor, "member": f"{member_id}-{i}",
+                "position": sensor["position"] - starts[i]}
+
+    return ExactFrame(nodes, members, dict(model.supports), (), names), where

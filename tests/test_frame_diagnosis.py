@@ -19,7 +19,7 @@ from gfe_opt.model import Effect
 from gfe_opt.problems import portal_frame, problem_file
 from gfe_opt.text import format_diagnosis
 
-from .frame_reference import ExactFrame
+from .frame_reference import ExactFrame, zone_frame
 
 NOISE = {"freq_noise": 0.0005, "shape_noise": 0.003}
 
@@ -221,6 +221,42 @@ def test_a_crack_near_a_column_base_is_found_on_that_column_at_its_place():
     assert crack.parameters["member"] == "left-column"
     assert abs(crack.parameters["position"] - a) < 0.02 * 0.3
     after = update(model, measured, d.add_arguments(), **NOISE)   # as printed
+    assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
+
+
+@pytest.mark.parametrize("start, end, ratio, seed", [
+    (0.21, 0.29, 1.6, 5),    # a doubler plate inside the beam
+    (0.0, 0.06, 2.5, 6),     # a haunch of the beam at joint B
+])
+def test_a_stiffer_zone_of_the_beam_is_a_section_loss_there(start, end, ratio, seed):
+    """Part of the beam deeper than modelled (I × ratio, A and ρA × its cube root): the exact
+    frame with the beam split at the zone's edges.  The diagnosis names a section loss on
+    the beam, its centre within 2 % of the beam's length, its added bending compliance
+    ℓ (1/r − 1)/EI within 10 %, drawn over its extent in the figure as the text gives it;
+    after it the model agrees."""
+    model = portal_frame()
+    beam = model.member("beam")
+    exact, where = zone_frame(model, "beam", start, end, ratio, ratio ** (1 / 3))
+    bracket = [Effect("section_loss", {"member": "beam", "position": (start + end) / 2,
+                                       "length": end - start, "stiffness_ratio": ratio,
+                                       "mass_ratio": ratio ** (1 / 3)})]
+    measured = _measured(model, exact, _guess(model, bracket), _sensors(model), seed, where)
+    d = _diagnose(model, measured, **NOISE)
+    assert d.verdict == "effect_found" and d.suggested == ["section_loss"], d.notes
+    zone = d.best.effects[0].parameters
+    assert zone["member"] == "beam"
+    assert abs(zone["position"] - (start + end) / 2) < 0.02 * model.member_length(beam)
+    compliance = zone["length"] * (1 / zone["stiffness_ratio"] - 1)
+    assert compliance == pytest.approx((end - start) * (1 / ratio - 1), rel=0.1)
+    from gfe_opt.report import diagnosis_figures
+
+    frame_axes, listing = diagnosis_figures(d, model)["frame_diagnosis.png"].axes
+    labels = [t.get_text() for t in listing.texts]
+    assert any(t.endswith(f"section_loss on beam at {zone['position']:.3g} m: length "
+                          f"{zone['length']:.3g} m, stiffness_ratio "
+                          f"{zone['stiffness_ratio']:.3g}, mass_ratio "
+                          f"{zone['mass_ratio']:.3g}") for t in labels), labels
+    after = update(model, measured, d.add_arguments(), **NOISE)
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 

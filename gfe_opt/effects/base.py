@@ -335,6 +335,13 @@ class EffectType:
         """Values that let a partly given frame effect (``--add``) be checked for its place."""
         return {"stiffness": 1.0}
 
+    def told_trades(self, model) -> tuple:
+        """Pairs of parameters (frozensets of keys) whose trade against each other leaves
+        the effect a finding: the data fix their combination, which is the physics (a short
+        zone's length and its ratios: its compliance).  Any other trade makes the effect not
+        estimable."""
+        return ()
+
     def check(self, model, params: dict, where: str, prefix: str) -> None:
         """Checks across parameters or against the model (override when needed)."""
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import GfeInputError
-from .base import EffectType, Parameter, Variable, position_variable
+from .base import EffectType, Parameter, Variable, frame_position_variable, position_variable
 
 
 def zone(centre: float, length: float, ratio: float):
@@ -40,8 +40,12 @@ class SectionLoss(EffectType):
     name = "section_loss"
     physics = "EI and ρA multiplied by stiffness_ratio and mass_ratio over a zone"
     signature = "a local drop of k over the zone's width and of the coefficient of ẅ"
-    kinds = ("beam", "bar")
+    kinds = ("beam", "bar", "frame")
     local = True
+    #: on a frame: EI × stiffness_ratio, ρA and EA × mass_ratio (the zone's area changes as
+    #: its mass, the material stays), over a zone of one member that may reach its joints
+    frame_parameters = (Parameter("member", "", "choice", "the member (a frame; position "
+                                  "of the zone's centre from its start node)"),)
     parameters = (
         Parameter("position", "m", "position", "centre of the zone"),
         Parameter("length", "m", "positive", "length of the zone"),
@@ -50,6 +54,17 @@ class SectionLoss(EffectType):
         Parameter("mass_ratio", "-", "range", "ρA inside over outside", lower=0.01,
                   upper=10.0, null=1.0),
     )
+
+    def told_trades(self, model):
+        """On a frame, a zone shorter than the modes resolve is told by its place, its added
+        compliance ℓ (1/r − 1) and its added mass ℓ (m − 1): its length against its ratios
+        is a finding, not a failure (a stiffer zone has no two-parameter equivalent, as a
+        crack is of a short softer one; chosen on the frame campaign's zone class).  Beams
+        keep the stricter rule their campaign judged."""
+        if model.kind != "frame":
+            return ()
+        keys = ("length", "stiffness_ratio", "mass_ratio")
+        return tuple(frozenset((a, b)) for i, a in enumerate(keys) for b in keys[i + 1:])
 
     def check(self, model, params, where, prefix):
         if "length" in params and params["length"] > model.length:
@@ -66,8 +81,10 @@ class SectionLoss(EffectType):
     def variables(self, model, fixed):
         # a zone may span any part of the structure, up to an end (a step in the section
         # over the outer half): no bound below the structure's length
-        return [position_variable(),
-                Variable("length", 0.004, 1.0, (0.05,), scale=lambda m: m.length),
+        span = _span(model, fixed)
+        return [frame_position_variable(model, model.member(fixed["member"]))
+                if model.kind == "frame" else position_variable(),
+                Variable("length", 0.004, 1.0, (0.05,), scale=lambda m: span),
                 # softer and stiffer alike (1/0.7): a start on one side only never found a
                 # stiffer zone, and which side a valley of frequencies alone ends on then
                 # hinged on rounding
@@ -82,7 +99,7 @@ class SectionLoss(EffectType):
         set of parameters (past the end, centre and length trade exactly)."""
         out = super().to_physical(model, variables, z, fixed)
         if "position" in out and "length" in out:
-            L = model.length
+            L = _span(model, fixed)
             a = max(out["position"] - out["length"] / 2.0, 0.0)
             b = min(out["position"] + out["length"] / 2.0, L)
             if b > a:
@@ -134,7 +151,14 @@ class SectionLoss(EffectType):
         z[i], z[j] = (a + b) / 2, b - a
         return z
 
+    def frame_placeholders(self, model, params):
+        span = model.member_length(model.member(params["member"]))
+        return {"position": 0.5 * span, "length": 0.05 * span, "stiffness_ratio": 0.7,
+                "mass_ratio": 1.0}
+
     def starts(self, model, hint):
+        if model.kind == "frame":   # along every member
+            return [{"member": m.id} for m in model.members]
         return [{}, *({"position": hint * model.length, "length": 0.05 * model.length,
                        "stiffness_ratio": ratio, "mass_ratio": 1.0} for ratio in (0.7, 1 / 0.7))]
 
@@ -145,6 +169,13 @@ class SectionLoss(EffectType):
         ax.annotate(f"EI×{params['stiffness_ratio']:.2f}, ρA×{params['mass_ratio']:.2f}",
                     (c, y), textcoords="offset points", xytext=(0, 9), ha="center",
                     fontsize=7, color="tab:orange")
+
+
+def _span(model, fixed) -> float:
+    """The length a zone lies along: the structure's, or on a frame its member's."""
+    if model.kind == "frame":
+        return model.member_length(model.member(fixed["member"]))
+    return model.length
 
 
 EFFECT = SectionLoss()
