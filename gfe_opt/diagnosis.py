@@ -581,10 +581,12 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
         kind = effect_type(f.name)
         f.gain = sel.reference_chi2 - f.misfit.chi2
         f.size_sigmas = kind.size_in_sigmas(base, f.parameters, f.uncertainty)
-        if any(kind.parameter(k).null is not None for k in f.bound):
-            # a parameter on a bound of its range has no σ to measure a distance with: the
-            # distance from "no effect" is the likelihood ratio's, √(gain / floor) (what
-            # |value − null|/σ is for a linear model)
+        if any(kind.parameter(k).null is not None for k in f.bound) or f.traded:
+            # a parameter on a bound of its range has no σ to measure a distance with, nor
+            # one that trades as its effect allows (a short zone: "no effect" is a whole
+            # line, ratio 1 or length 0, and each σ spans the trade): the distance from "no
+            # effect" is the likelihood ratio's, √(gain / floor) (what |value − null|/σ is
+            # for a linear model)
             f.size_sigmas = float(np.sqrt(max(f.gain, 0.0) / sel.floor))
         f.threshold = sel.threshold(f)
         # what it explains alone exceeds its threshold, whatever its size's σ (one loose
@@ -1563,8 +1565,8 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
 def traded_note(fit) -> str:
     """What a fit whose parameters trade as its effect allows (:attr:`Fit.traded`) tells."""
     return (f"{fit.name}: " + "; ".join(fit.traded) + ": the data fix their combination (a "
-            "zone's added compliance ℓ (1/r − 1) and mass ℓ (m − 1)), not each; their ± "
-            "understate that trade")
+            "zone's added compliance ℓ (1/r − 1) and mass ℓ (m − 1)), not each value; each ± "
+            "is taken along that trade")
 
 
 def drop_indices(model: Model, drop) -> set:

@@ -1016,6 +1016,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     else:
         sd_z = sd
     names, unidentified = [], []
+    wide = {}   # variable -> its σ above its value
     i = 0
     for j, slot in enumerate(slots):
         for v in slot.variables:
@@ -1032,7 +1033,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
             rule = slot.effect.parameter(v.key).rule if v.index is None else "ratios"
             if slot.added and rule in ("positive", "fraction") and not value <= abs(phys) \
                     and not held[i]:
-                unidentified.append(f"{label}: σ {value:.3g} exceeds its value {phys:.3g}")
+                wide[i] = (j, v.key, f"{label}: σ {value:.3g} exceeds its value {phys:.3g}")
             i += 1
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(sd, sd)
@@ -1058,6 +1059,8 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
                 rises.append(float(rr @ rr) - chi0)
         return not rises or min(rises) < s2
 
+    in_trade = set()   # (slot, key) of the parameters in a told trade
+
     def told(a, b) -> bool:
         """Two parameters of one effect whose trade the effect declares a finding
         (:meth:`~gfe_opt.effects.base.EffectType.told_trades`: a short zone's length and
@@ -1066,7 +1069,10 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
             return False
         keys = {TIE_KEYS.get(k, k) for k in (names[a].split(".", 1)[1],
                                              names[b].split(".", 1)[1])}
-        return keys in slots[owner[a]].effect.told_trades(base)
+        if keys not in slots[owner[a]].effect.told_trades(base):
+            return False
+        in_trade.update((owner[a], k) for k in keys)
+        return True
 
     traded = []
     for a in range(m):
@@ -1076,6 +1082,10 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
                 (traded if told(a, b) else unidentified).append(
                     f"{names[a]} and {names[b]} trade against each other (correlation "
                     f"{corr[a, b]:+.3f})")
+    # a σ above its value that a told trade explains is that trade's (a short zone's
+    # length spans it), any other undetermines the effect
+    for i, (j, key, sentence) in wide.items():
+        (traded if (j, key) in in_trade else unidentified).append(sentence)
     return out, unidentified, traded
 
 

@@ -36,6 +36,12 @@ def _on_ends(variables, z):
 PAST_END = 0.05
 
 
+#: on a frame, a zone from each end of a member (a haunch, a corroded foot) is one more
+#: start, this fraction of the member long: the grid's zones (0.05 of it) lie inside, and
+#: IPOPT stopped short of an end when the zone reaches it (the residual's kink there)
+END_ZONE = 0.2
+
+
 class SectionLoss(EffectType):
     name = "section_loss"
     physics = "EI and ρA multiplied by stiffness_ratio and mass_ratio over a zone"
@@ -157,8 +163,14 @@ class SectionLoss(EffectType):
                 "mass_ratio": 1.0}
 
     def starts(self, model, hint):
-        if model.kind == "frame":   # along every member
-            return [{"member": m.id} for m in model.members]
+        if model.kind == "frame":   # along every member; and from each of its ends
+            out = []
+            for m in model.members:
+                span = model.member_length(m)
+                out += [{"member": m.id}, *({"member": m.id, "position": c * span,
+                                             "length": END_ZONE * span} for c in
+                                            (END_ZONE / 2, 1 - END_ZONE / 2))]
+            return out
         return [{}, *({"position": hint * model.length, "length": 0.05 * model.length,
                        "stiffness_ratio": ratio, "mass_ratio": 1.0} for ratio in (0.7, 1 / 0.7))]
 
