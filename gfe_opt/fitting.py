@@ -1016,7 +1016,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     else:
         sd_z = sd
     names, unidentified = [], []
-    wide = {}   # variable -> its σ above its value
+    wide = {}   # variable -> (slot, key, its σ above its value)
     i = 0
     for j, slot in enumerate(slots):
         for v in slot.variables:
@@ -1084,7 +1084,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
                     f"{corr[a, b]:+.3f})")
     # a σ above its value that a told trade explains is that trade's (a short zone's
     # length spans it), any other undetermines the effect
-    for i, (j, key, sentence) in wide.items():
+    for j, key, sentence in wide.values():
         (traded if (j, key) in in_trade else unidentified).append(sentence)
     return out, unidentified, traded
 
