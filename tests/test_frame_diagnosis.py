@@ -260,6 +260,35 @@ def test_a_stiffer_zone_of_the_beam_is_a_section_loss_there(start, end, ratio, s
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
+def test_a_zone_shorter_than_the_modes_resolve_is_named_by_its_compliance():
+    """2 cm of the right column (7 % of it) twice as stiff, at 1.7 times the usual noise
+    (stated): six modes at two sensors a member cannot tell its length from its ratios.
+    The diagnosis still names a section loss there (its distance from nothing the
+    likelihood ratio's), its centre within 2 % of the column, its added compliance
+    ℓ (1/r − 1) within 10 %, and says which parameters trade (the JSON's ``traded``, not
+    ``not_estimable``); after it the model agrees."""
+    model = portal_frame()
+    a, b, ratio = 0.09, 0.11, 2.0
+    exact, where = zone_frame(model, "right-column", a, b, ratio, ratio ** (1 / 3))
+    bracket = [Effect("section_loss", {"member": "right-column", "position": 0.1,
+                                       "length": 0.02, "stiffness_ratio": ratio,
+                                       "mass_ratio": ratio ** (1 / 3)})]
+    noise = {k: 1.7 * v for k, v in NOISE.items()}
+    measured = _measured(model, exact, _guess(model, bracket), _sensors(model), 8, where,
+                         noise)
+    d = _diagnose(model, measured, **noise)
+    assert d.verdict == "effect_found" and d.suggested == ["section_loss"], d.notes
+    zone = d.best.effects[0].parameters
+    assert zone["member"] == "right-column" and abs(zone["position"] - 0.1) < 0.02 * 0.3
+    assert zone["length"] * (1 / zone["stiffness_ratio"] - 1) == pytest.approx(
+        (b - a) * (1 / ratio - 1), rel=0.1)
+    entry = next(e for e in d.to_json()["effects"] if e["effect"] == "section_loss")
+    assert entry["traded"] and not entry["not_estimable"]
+    assert any("the data fix their combination" in n for n in d.notes), d.notes
+    after = update(model, measured, d.add_arguments(), **noise)
+    assert diagnose(after.model, measured, **noise).verdict == "consistent"
+
+
 def test_a_mass_added_at_a_joint_is_a_point_mass_there():
     """0.1 kg at joint C (the beam weighs 0.157 kg): a point mass at C (an end of the beam
     or of the right column: one place), within 10 %, then consistent."""
