@@ -359,8 +359,8 @@ class Fit:
     #: diagnosis; a place that fits as well is said)
     other_places: list = field(default_factory=list)
     unidentified: list = field(default_factory=list)  # parameters these data do not estimate
-    #: trades the effect declares a finding (a short zone: its length against its ratios;
-    #: the combination is told, each σ understates its own range): sentences
+    #: trades the effect declares a finding (on a frame a short zone: its length against
+    #: its ratios; the data fix the combination, not each value): sentences
     traded: list = field(default_factory=list)
     #: per effect, parameters that ended on a bound of their range: {key: "at least" |
     #: "at most"} (the data tell one side only)

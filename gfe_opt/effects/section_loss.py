@@ -65,8 +65,9 @@ class SectionLoss(EffectType):
         """On a frame, a zone shorter than the modes resolve is told by its place, its added
         compliance ℓ (1/r − 1) and its added mass ℓ (m − 1): its length against its ratios
         is a finding, not a failure (a stiffer zone has no two-parameter equivalent, as a
-        crack is of a short softer one; chosen on the frame campaign's zone class).  Beams
-        keep the stricter rule their campaign judged."""
+        crack is of a short softer one; found on the frame campaign's zone-3107, a 4 cm
+        stiffer zone that otherwise left a crack on the wrong column).  Beams keep the
+        stricter rule their campaign judged."""
         if model.kind != "frame":
             return ()
         keys = ("length", "stiffness_ratio", "mass_ratio")
