@@ -2,7 +2,8 @@
 tests the package did not build, scored (the frames' counterpart of
 scripts/bench_diagnosis.py).
 
-    python scripts/bench_frame_diagnosis.py --seed S [--cases N] [--json out.json]
+    python scripts/bench_frame_diagnosis.py --seed S [--cases N] [--classes none,zone]
+        [--json out.json]
 
 Each case is the portal of ``problems/portal-frame.toml`` "measured" from the exact dynamic
 stiffness solution of ``tests/frame_reference.py`` (no gfe-opt element in it; issue 24's
@@ -307,11 +308,17 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=3100)
     ap.add_argument("--cases", type=int, default=4, help="cases per class")
     ap.add_argument("--json", help="write the document to this file too")
+    ap.add_argument("--classes", help="comma-separated classes to run (default: all); each "
+                    "case keeps the seed it has in the full campaign")
     args = ap.parse_args(argv)
     diagnosis.SERIAL_FITS = True    # one core per campaign: run seeds side by side
     rows = []
+    chosen = CLASSES if not args.classes else args.classes.split(",")
+    unknown = sorted(set(chosen) - set(CLASSES))
+    if unknown:
+        ap.error(f"--classes: unknown {', '.join(unknown)} (known: {', '.join(CLASSES)})")
     seeds = [(args.seed + 10 * i + j, g) for i in range(args.cases)
-             for j, g in enumerate(CLASSES)]
+             for j, g in enumerate(CLASSES) if g in chosen]
     for n, (seed, group) in enumerate(seeds, start=1):
         start = time.perf_counter()
         case = make_case(seed, group)
