@@ -200,7 +200,9 @@ def zone_frame(model, member_id, a, b, stiffness_ratio, area_ratio):
     nodes, members, names = dict(model.nodes), [], []
     cuts = [(0.0, member.start)]
     for t, name in ((a, "Z1"), (b, "Z2")):
-        if 0.0 < t < L:
+        # a part shorter than 1e-3 of the member is its end (the exact member's end
+        # conditions lose rank as its length goes to 0: a draw 1e-6 from an end failed)
+        if 1e-3 * L < t < (1 - 1e-3) * L:
             nodes[name] = (x0 + t / L * (x1 - x0), y0 + t / L * (y1 - y0))
             cuts.append((t, name))
     cuts.append((L, member.end))
@@ -210,7 +212,7 @@ def zone_frame(model, member_id, a, b, stiffness_ratio, area_ratio):
             names.append(m.id)
             continue
         for i, ((t0, n0), (t1, n1)) in enumerate(zip(cuts[:-1], cuts[1:])):
-            inside = a <= t0 and t1 <= b
+            inside = a - 1e-3 * L <= t0 and t1 <= b + 1e-3 * L
             members.append((n0, n1, m.E, m.rho, m.area * (area_ratio if inside else 1.0),
                             m.inertia * (stiffness_ratio if inside else 1.0)))
             names.append(f"{m.id}-{i}")

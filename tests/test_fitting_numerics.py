@@ -128,28 +128,32 @@ def test_mode_sign_follows_the_first_of_equal_peaks():
         assert row == 10 and shaped[row, 0] > 0
 
 
-def _two_parameter_slot():
-    """A stand-in for one added effect with two 'positive' parameters a and b."""
+def _two_parameter_slot(told=()):
+    """A stand-in for one added effect with two 'positive' parameters a and b (``told``:
+    the trades it declares a finding)."""
     from types import SimpleNamespace
 
     from gfe_opt.effects.base import Parameter, Variable
 
     params = {k: Parameter(k, "-", "positive", k) for k in ("a", "b")}
     effect = SimpleNamespace(name="toy", parameter=params.__getitem__,
-                             tie=lambda model, variables, z: None)
+                             tie=lambda model, variables, z: None,
+                             told_trades=lambda model: told)
     variables = [Variable(k, 0.01, 10.0, (1.0,)) for k in ("a", "b")]
     return [SimpleNamespace(effect=effect, variables=variables, added=True)]
 
 
-def _sigma_of(residual, z):
+def _sigma_of(residual, z, told=()):
+    """σ and the not-estimable sentences (with ``told``, also the told trades')."""
     from types import SimpleNamespace
 
     from gfe_opt.fitting import _uncertainty
 
     r = residual(z)
     misfit = SimpleNamespace(chi2=float(r @ r), n_residuals=r.size)
-    return _uncertainty(residual, z, _two_parameter_slot(), None, misfit,
-                        np.full(2, 0.01), np.full(2, 10.0))
+    sigma, unidentified, traded = _uncertainty(residual, z, _two_parameter_slot(told), None,
+                                               misfit, np.full(2, 0.01), np.full(2, 10.0))
+    return (sigma, unidentified, traded) if told else (sigma, unidentified)
 
 
 def test_a_correlation_alone_does_not_make_parameters_inestimable():
@@ -175,3 +179,21 @@ def test_a_curved_valley_is_a_trade_the_linear_sigma_misses():
 
     _, unidentified = _sigma_of(residual, np.array([1.0, 2.0]))
     assert any("trade against each other" in u for u in unidentified), unidentified
+
+
+def test_a_trade_the_effect_declares_a_finding_is_told_not_inestimable():
+    """The same curved valley where the effect declares a and b's trade a finding (a short
+    zone's length and ratio on a frame: only the product is the physics): the sentence moves
+    to ``traded``; a σ above its value along that trade goes with it; nothing is left not
+    estimable."""
+    def residual(z):   # a·b = 2 measured, a and b alone barely (σ above a's value)
+        return np.array([1e3 * (z[0] * z[1] - 2.0), 0.002 * (z[0] - 1.0),
+                         0.002 * (z[1] - 2.0)])
+
+    _, unidentified = _sigma_of(residual, np.array([1.0, 2.0]))
+    assert any("exceeds its value" in u for u in unidentified), unidentified
+    _, unidentified, traded = _sigma_of(residual, np.array([1.0, 2.0]),
+                                        told=(frozenset(("a", "b")),))
+    assert unidentified == [], unidentified
+    assert any("trade against each other" in t for t in traded), traded
+    assert any("exceeds its value" in t for t in traded), traded
