@@ -22,6 +22,10 @@ Model file (``kind = "frame"``; README "Plane frames")::
                  effect = "joint_spring": node, member, stiffness (N m/rad)
                  effect = "support_spring": node, stiffness (N m/rad; a support's rotation)
                  effect = "support_translation": node, direction = "x" | "y", stiffness (N/m)
+                 effect = "point_mass": member, position, mass (kg)
+                 effect = "axial_stiffness": member, ratio;  effect = "material": E (Pa)
+                 effect = "section_loss": member, position (the zone's centre), length (m),
+                          stiffness_ratio (EI), mass_ratio (ρA and EA)
 
 Frames have modes (:func:`frame_modes`, ``gfe-opt modes``), are compared with tests
 (:mod:`gfe_opt.frame_data`) and go through the beam's fits (:class:`FrameDiscretisation`:
