@@ -686,17 +686,24 @@ def axial_rigidity(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
     factor = model.stiffness_factor
     out = np.array([factor * model.members[k].E * model.members[k].area
                     * ratio.get(model.members[k].id, 1.0) for k in mesh.element_member])
+    for e, _, L, x, w, zones in _zoned_quadrature(model, mesh):
+        out[e] *= L / np.sum(w / _zone_factor(zones, 3)(x))
+    return out
+
+
+def _zoned_quadrature(model: FrameModel, mesh: FrameMesh):
+    """For each element a section-loss zone covers, even in part: (element, its start x0
+    and length L along its member, quadrature points x and weights w exact for the zones'
+    piecewise-constant ratios, the member's zones)."""
     for k, member in enumerate(model.members):
         zones = _zones(model, member.id)
         if not zones:
             continue
         L = model.member_length(member) / member.elements
         first = int(np.flatnonzero(mesh.element_member == k)[0])
-        area = _zone_factor(zones, 3)
         for j in _zoned_elements(zones, L, member.elements):
             x, w = el.element_quadrature(j * L, (j + 1) * L, _edges(zones, j * L, L))
-            out[first + j] *= L / np.sum(w / area(x))
-    return out
+            yield first + j, j * L, L, x, w, zones
 
 
 def _edges(zones, x0: float, L: float) -> tuple:
@@ -708,23 +715,14 @@ def _zone_masses(model: FrameModel, mesh: FrameMesh, rhoA) -> dict:
     """{element: (6, 6) local mass added by the section-loss zones over it}: ρA (mass ratio
     − 1) ∫ NᵀN over the part covered (bar and beam shape functions, exact quadrature)."""
     out = {}
-    for k, member in enumerate(model.members):
-        zones = _zones(model, member.id)
-        if not zones:
-            continue
-        L = model.member_length(member) / member.elements
-        first = int(np.flatnonzero(mesh.element_member == k)[0])
-        change = _zone_factor(zones, 3)
-        scaling = el.beam_dof_scaling(np.array([L]))[0]
-        for j in _zoned_elements(zones, L, member.elements):
-            x, w = el.element_quadrature(j * L, (j + 1) * L, _edges(zones, j * L, L))
-            c = rhoA[first + j] * w * (change(x) - 1.0)
-            s = (x - j * L) / L
-            added = np.zeros((6, 6))
-            bar, beam = el.linear(s), el.hermite(s) * scaling
-            added[np.ix_([0, 3], [0, 3])] = bar.T @ (c[:, None] * bar)
-            added[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = beam.T @ (c[:, None] * beam)
-            out[first + j] = added
+    for e, x0, L, x, w, zones in _zoned_quadrature(model, mesh):
+        c = rhoA[e] * w * (_zone_factor(zones, 3)(x) - 1.0)
+        s = (x - x0) / L
+        added = np.zeros((6, 6))
+        bar, beam = el.linear(s), el.hermite(s) * el.beam_dof_scaling(np.array([L]))[0]
+        added[np.ix_([0, 3], [0, 3])] = bar.T @ (c[:, None] * bar)
+        added[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = beam.T @ (c[:, None] * beam)
+        out[e] = added
     return out
 
 
