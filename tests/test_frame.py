@@ -140,7 +140,7 @@ def test_a_section_loss_on_a_member_converges_to_its_split_members_exact_frequen
     assert 3.5 < rate < 5.0
 
 
-def test_a_section_loss_adds_its_mass_and_nothing_else():
+def test_a_section_loss_adds_exactly_its_mass():
     """The mass matrix of a frame with a zone moves rigidly with the frame's total mass plus
     ρA (mass_ratio − 1) × the zone's length: the zone's mass integrated exactly, its edges
     inside elements."""
