@@ -511,6 +511,9 @@ class FrameMesh:
     grounded: tuple                 # (dof, k): a support that gives
     n_dof: int
     constrained: np.ndarray
+    #: the sparse patterns of K and M (:func:`_assemble`), computed once a mesh and shared
+    #: by the copies that carry other spring values
+    patterns: dict = field(default_factory=dict, compare=False, repr=False)
 
 
 #: the meshes built, by what decides their nodes and numbering (:func:`_mesh_key`): a fit
@@ -633,77 +636,113 @@ def _zoned_elements(zones, step: float, count: int) -> list[int]:
     return sorted(out)
 
 
-def bending_parameters(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
-    """(n_el, 3): k_ww, k_wθ, k_θθ of each element [N m²] (eq. 11): Euler–Bernoulli, or
-    the exact static element of EI(x) where a crack's disturbance or a section loss's zone
-    (EI × its stiffness ratio) reaches."""
-    factor = model.stiffness_factor
-    EI = np.array([factor * model.members[k].E * model.members[k].inertia
-                   for k in mesh.element_member])
+#: the effects that change a member's elements (the others act at joints, supports and
+#: places: springs, masses, applied in :func:`frame_matrices`)
+_ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness")
+
+
+@dataclass(frozen=True)
+class MemberElements:
+    """One member's elements: bending parameters k_ww, k_wθ, k_θθ (n, 3) [N m²], axial
+    rigidity EA (n,) [N], stiffness and mass matrices (n, 6, 6) in global axes."""
+
+    bending: np.ndarray
+    axial: np.ndarray
+    K: np.ndarray
+    M: np.ndarray
+
+
+#: members' elements computed, by everything that decides them (:func:`_member_key`): a fit
+#: changes one member (a crack, a zone) or none (a spring, a mass), and recomputing every
+#: member's elements at every evaluation was a third of a three-storey frame's diagnosis
+_MEMBER_ELEMENTS: dict = {}
+_MEMBER_ELEMENTS_KEPT = 256
+
+
+def _member_key(model: FrameModel, k: int, raw: list) -> tuple:
+    m = model.members[k]
+    return (m, tuple(model.nodes[m.start]), tuple(model.nodes[m.end]), model.stiffness_factor,
+            tuple(tuple(e.items()) for e in raw
+                  if e["effect"] in _ELEMENT_EFFECTS and e["member"] == m.id))
+
+
+def member_elements(model: FrameModel) -> list[MemberElements]:
+    """Each member's :class:`MemberElements` (in member order; read-only arrays, shared by
+    every model whose member is the same, with the same effects on it)."""
+    raw = model.raw_effects
+    out = []
+    for k in range(len(model.members)):
+        key = _member_key(model, k, raw)
+        kept = _MEMBER_ELEMENTS.get(key)
+        if kept is None:
+            kept = _member_elements(model, k)
+            for array in (kept.bending, kept.axial, kept.K, kept.M):
+                array.flags.writeable = False
+            if len(_MEMBER_ELEMENTS) >= _MEMBER_ELEMENTS_KEPT:
+                _MEMBER_ELEMENTS.clear()
+            _MEMBER_ELEMENTS[key] = kept
+        out.append(kept)
+    return out
+
+
+def _member_bending(model: FrameModel, member: Member, L: float) -> np.ndarray:
+    """(n, 3): k_ww, k_wθ, k_θθ of each element of ``member`` (each ``L`` long) [N m²]
+    (eq. 11): Euler–Bernoulli, or the exact static element of EI(x) where a crack's
+    disturbance or a section loss's zone (EI × its stiffness ratio) reaches."""
+    ei0 = model.stiffness_factor * member.E * member.inertia
+    EI = np.full(member.elements, ei0)
     out = np.stack([12.0 * EI, 6.0 * EI, 4.0 * EI], axis=1)
-    for k, member in enumerate(model.members):
-        cracks = [(e["position"], e["depth_ratio"]) for e in model.raw_effects
-                  if e["effect"] == "crack" and e["member"] == member.id]
-        zones = _zones(model, member.id)
-        if not cracks and not zones:
-            continue
-        from .effects.crack import CRACK_REACH
+    cracks = [(e["position"], e["depth_ratio"]) for e in model.raw_effects
+              if e["effect"] == "crack" and e["member"] == member.id]
+    zones = _zones(model, member.id)
+    if not cracks and not zones:
+        return out
+    from .effects.crack import CRACK_REACH
 
-        half = None if member.depth is None else member.depth / 2.0
-        decay = None if not cracks else half / (2.0 * el.SHEN_PIERRE_GAMMA)
-        ei0 = factor * member.E * member.inertia
-        L = model.member_length(member) / member.elements
-        first = int(np.flatnonzero(mesh.element_member == k)[0])
-        zoned = _zone_factor(zones, 2)
+    half = None if member.depth is None else member.depth / 2.0
+    decay = None if not cracks else half / (2.0 * el.SHEN_PIERRE_GAMMA)
+    zoned = _zone_factor(zones, 2)
 
-        def rigidity(x, cracks=cracks, half=half, ei0=ei0, zoned=zoned):
-            q = zoned(x)
-            for x_c, ratio in cracks:
-                q = q * el.christides_barr_q(x, x_c, ratio, half)
-            return ei0 * q
+    def rigidity(x):
+        q = zoned(x)
+        for x_c, ratio in cracks:
+            q = q * el.christides_barr_q(x, x_c, ratio, half)
+        return ei0 * q
 
-        reached = set(_zoned_elements(zones, L, member.elements))
-        for x_c, _ in cracks:
-            lo = max(int((x_c - CRACK_REACH * decay) // L), 0)
-            hi = min(int((x_c + CRACK_REACH * decay) // L) + 1, member.elements)
-            reached.update(range(lo, hi))
-        for j in sorted(reached):
-            x0 = j * L
-            inside = (*(x_c for x_c, _ in cracks if x0 < x_c < x0 + L),
-                      *_edges(zones, x0, L))
-            out[first + j] = el.beam_stiffness_from_flexibility(
-                rigidity, x0, L, breakpoints=inside, refine_scale=decay)
+    reached = set(_zoned_elements(zones, L, member.elements))
+    for x_c, _ in cracks:
+        lo = max(int((x_c - CRACK_REACH * decay) // L), 0)
+        hi = min(int((x_c + CRACK_REACH * decay) // L) + 1, member.elements)
+        reached.update(range(lo, hi))
+    for j in sorted(reached):
+        x0 = j * L
+        inside = (*(x_c for x_c, _ in cracks if x0 < x_c < x0 + L), *_edges(zones, x0, L))
+        out[j] = el.beam_stiffness_from_flexibility(rigidity, x0, L, breakpoints=inside,
+                                                    refine_scale=decay)
     return out
 
 
-def axial_rigidity(model: FrameModel, mesh: FrameMesh) -> np.ndarray:
-    """EA of each element [N], times the ``ratio`` of an ``axial_stiffness`` effect on its
-    member (a loose brace); where a section loss's zone covers an element, that of the
-    element's exact axial flexibility ∫ dx / EA(x) (EA × the zone's mass ratio: the zone's
-    area changes as its mass, the material stays)."""
-    ratio = {e["member"]: e["ratio"] for e in model.raw_effects
-             if e["effect"] == "axial_stiffness"}
-    factor = model.stiffness_factor
-    out = np.array([factor * model.members[k].E * model.members[k].area
-                    * ratio.get(model.members[k].id, 1.0) for k in mesh.element_member])
-    for e, _, L, x, w, zones in _zoned_quadrature(model, mesh):
-        out[e] *= L / np.sum(w / _zone_factor(zones, 3)(x))
+def _member_axial(model: FrameModel, member: Member, L: float) -> np.ndarray:
+    """(n,): EA of each element of ``member`` [N], times the ``ratio`` of an
+    ``axial_stiffness`` effect on it (a loose brace); where a section loss's zone covers an
+    element, that of the element's exact axial flexibility ∫ dx / EA(x) (EA × the zone's
+    mass ratio: the zone's area changes as its mass, the material stays)."""
+    ratio = next((e["ratio"] for e in model.raw_effects
+                  if e["effect"] == "axial_stiffness" and e["member"] == member.id), 1.0)
+    out = np.full(member.elements, model.stiffness_factor * member.E * member.area * ratio)
+    zones = _zones(model, member.id)
+    for j, _, x, w in _zoned_quadrature(zones, L, member.elements):
+        out[j] *= L / np.sum(w / _zone_factor(zones, 3)(x))
     return out
 
 
-def _zoned_quadrature(model: FrameModel, mesh: FrameMesh):
-    """For each element a section-loss zone covers, even in part: (element, its start x0
-    and length L along its member, quadrature points x and weights w exact for the zones'
-    piecewise-constant ratios, the member's zones)."""
-    for k, member in enumerate(model.members):
-        zones = _zones(model, member.id)
-        if not zones:
-            continue
-        L = model.member_length(member) / member.elements
-        first = int(np.flatnonzero(mesh.element_member == k)[0])
-        for j in _zoned_elements(zones, L, member.elements):
-            x, w = el.element_quadrature(j * L, (j + 1) * L, _edges(zones, j * L, L))
-            yield first + j, j * L, L, x, w, zones
+def _zoned_quadrature(zones, L: float, count: int):
+    """For each element of a member (``count`` elements ``L`` long) that a section-loss
+    zone covers, even in part: (its index, its start x0 along the member, quadrature points
+    x and weights w exact for the zones' piecewise-constant ratios)."""
+    for j in _zoned_elements(zones, L, count):
+        x, w = el.element_quadrature(j * L, (j + 1) * L, _edges(zones, j * L, L))
+        yield j, j * L, x, w
 
 
 def _edges(zones, x0: float, L: float) -> tuple:
@@ -711,49 +750,68 @@ def _edges(zones, x0: float, L: float) -> tuple:
     return tuple(edge for z in zones for edge in z[:2] if x0 < edge < x0 + L)
 
 
-def _zone_masses(model: FrameModel, mesh: FrameMesh, rhoA) -> dict:
-    """{element: (6, 6) local mass added by the section-loss zones over it}: ρA (mass ratio
-    − 1) ∫ NᵀN over the part covered (bar and beam shape functions, exact quadrature)."""
-    out = {}
-    for e, x0, L, x, w, zones in _zoned_quadrature(model, mesh):
-        c = rhoA[e] * w * (_zone_factor(zones, 3)(x) - 1.0)
-        s = (x - x0) / L
-        added = np.zeros((6, 6))
-        bar, beam = el.linear(s), el.hermite(s) * el.beam_dof_scaling(np.array([L]))[0]
-        added[np.ix_([0, 3], [0, 3])] = bar.T @ (c[:, None] * bar)
-        added[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = beam.T @ (c[:, None] * beam)
-        out[e] = added
-    return out
+def _zone_mass(zones, rhoA: float, x0: float, L: float, x, w) -> np.ndarray:
+    """(6, 6) local mass a member's section-loss zones add to the element [x0, x0 + L]:
+    ρA (mass ratio − 1) ∫ NᵀN over the part covered (bar and beam shape functions, exact
+    quadrature ``x``, ``w``)."""
+    c = rhoA * w * (_zone_factor(zones, 3)(x) - 1.0)
+    s = (x - x0) / L
+    added = np.zeros((6, 6))
+    bar, beam = el.linear(s), el.hermite(s) * el.beam_dof_scaling(np.array([L]))[0]
+    added[np.ix_([0, 3], [0, 3])] = bar.T @ (c[:, None] * bar)
+    added[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = beam.T @ (c[:, None] * beam)
+    return added
 
 
-def element_matrices(model: FrameModel, mesh: FrameMesh):
-    """(K_e, M_e), each (n_el, 6, 6) in global axes: bar ⊕ beam in the member's axes,
-    rotated by T = diag(R, R)."""
-    n = mesh.element_length.size
-    L = mesh.element_length
-    EA = axial_rigidity(model, mesh)
-    rhoA = np.array([model.members[k].rho * model.members[k].area
-                     for k in mesh.element_member])
+def _member_elements(model: FrameModel, k: int) -> MemberElements:
+    """One member's elements: bar ⊕ beam in the member's axes, rotated into global axes by
+    T = diag(R, R)."""
+    member = model.members[k]
+    n = member.elements
+    (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
+    length = math.hypot(x1 - x0, y1 - y0)
+    L = np.full(n, length / member.elements)
+    EA = _member_axial(model, member, L[0])
+    rhoA = np.full(n, member.rho * member.area)
     local_k = np.zeros((n, 6, 6))
     local_m = np.zeros((n, 6, 6))
     axial, bend = [0, 3], [1, 2, 4, 5]
     local_k[np.ix_(range(n), axial, axial)] = el.generic_bar_stiffness(EA, L)
     local_m[np.ix_(range(n), axial, axial)] = el.generic_bar_mass(
         rhoA, L, np.full(n, el.BAR_MASS_BETA["consistent"]))
-    p = bending_parameters(model, mesh)
+    p = _member_bending(model, member, L[0])
     P = np.stack([np.stack([p[:, 0], p[:, 1]], -1), np.stack([p[:, 1], p[:, 2]], -1)], -2)
     H = el.BEAM_DEFORMATION_H
     scaling = el.beam_dof_scaling(L)                     # (n, 4)
     scaled = np.einsum("ji,ejk,kl->eil", H, P, H) / L[:, None, None] ** 3
     local_k[np.ix_(range(n), bend, bend)] = scaled * scaling[:, :, None] * scaling[:, None, :]
     mass = (rhoA * L)[:, None, None] * el.symmetric_beam_mass(
-        **{k: np.full(n, v) for k, v in el.CONSISTENT_BEAM_MASS.items()})
+        **{key: np.full(n, v) for key, v in el.CONSISTENT_BEAM_MASS.items()})
     local_m[np.ix_(range(n), bend, bend)] = mass * scaling[:, :, None] * scaling[:, None, :]
-    for e, added in _zone_masses(model, mesh, rhoA).items():
-        local_m[e] += added
-    T = rotations(mesh.cosines)
+    zones = _zones(model, member.id)
+    for j, start, x, w in _zoned_quadrature(zones, L[0], n):
+        local_m[j] += _zone_mass(zones, rhoA[j], start, L[0], x, w)
+    T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
     Tt = np.swapaxes(T, 1, 2)
-    return Tt @ local_k @ T, Tt @ local_m @ T
+    return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T)
+
+
+def bending_parameters(model: FrameModel, mesh: FrameMesh | None = None) -> np.ndarray:
+    """(n_el, 3): k_ww, k_wθ, k_θθ of every element [N m²], member by member
+    (:func:`_member_bending`)."""
+    return np.concatenate([m.bending for m in member_elements(model)])
+
+
+def axial_rigidity(model: FrameModel, mesh: FrameMesh | None = None) -> np.ndarray:
+    """(n_el,): EA of every element [N], member by member (:func:`_member_axial`)."""
+    return np.concatenate([m.axial for m in member_elements(model)])
+
+
+def element_matrices(model: FrameModel, mesh: FrameMesh | None = None):
+    """(K_e, M_e), each (n_el, 6, 6) in global axes: bar ⊕ beam in the member's axes,
+    rotated by T = diag(R, R)."""
+    members = member_elements(model)
+    return (np.concatenate([m.K for m in members]), np.concatenate([m.M for m in members]))
 
 
 def rotations(cosines) -> np.ndarray:
@@ -771,17 +829,11 @@ def rotations(cosines) -> np.ndarray:
 def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
     """Global (K, M), sparse, all DOFs (supports not applied)."""
     mesh = frame_mesh(model) if mesh is None else mesh
-    Ke, Me = element_matrices(model, mesh)
-    rows = np.repeat(mesh.element_dofs, 6, axis=1).ravel()
-    cols = np.tile(mesh.element_dofs, (1, 6)).ravel()
-    shape = (mesh.n_dof, mesh.n_dof)
-    K = sp.coo_matrix((Ke.ravel(), (rows, cols)), shape=shape).tocsr()
-    M = sp.coo_matrix((Me.ravel(), (rows, cols)), shape=shape).tocsr()
-    for a, b, k in mesh.springs:
-        K = K + sp.csr_matrix(([k, -k, -k, k], ([a, a, b, b], [a, b, a, b])), shape=shape)
-    if mesh.grounded:
-        dof, k = zip(*mesh.grounded)
-        K = K + sp.csr_matrix((k, (dof, dof)), shape=shape)
+    Ke, Me = element_matrices(model)
+    springs = [v for _, _, k in mesh.springs for v in (k, -k, -k, k)]
+    K = _assemble(mesh, "K", np.concatenate([Ke.ravel(), springs,
+                                             [k for _, k in mesh.grounded]]))
+    M = _assemble(mesh, "M", Me.ravel())
     masses = [e for e in model.raw_effects if e["effect"] == "point_mass"]
     if masses:   # not the kept observations: a fitted mass moves at every evaluation
         from .frame_data import build_observation as observation
@@ -794,6 +846,32 @@ def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
         m = np.repeat([e["mass"] for e in masses], 2)
         M = M + (C.T @ sp.diags(m) @ C).tocsr()
     return K, M
+
+
+def _assemble(mesh: FrameMesh, which: str, values) -> sp.csr_matrix:
+    """The sparse sum of ``values`` over the mesh's entries (``"K"``: the elements' 36 a
+    element, then each joint spring's four, then each ground spring's one; ``"M"``: the
+    elements' alone), into a pattern computed once a mesh (kept with it): the entries added
+    in their order, as a COO sum would, without sorting them at every evaluation."""
+    pattern = mesh.patterns.get(which)
+    if pattern is None:
+        rows = [np.repeat(mesh.element_dofs, 6, axis=1).ravel()]
+        cols = [np.tile(mesh.element_dofs, (1, 6)).ravel()]
+        if which == "K":
+            for a, b, _ in mesh.springs:
+                rows.append(np.array([a, a, b, b]))
+                cols.append(np.array([a, b, a, b]))
+            rows.append(np.array([dof for dof, _ in mesh.grounded], dtype=int))
+            cols.append(rows[-1])
+        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        n = mesh.n_dof
+        unique, slot = np.unique(rows * n + cols, return_inverse=True)
+        indptr = np.searchsorted(unique // n, np.arange(n + 1))
+        pattern = (indptr, unique % n, slot, unique.size)
+        mesh.patterns[which] = pattern
+    indptr, indices, slot, size = pattern
+    data = np.bincount(slot, weights=values, minlength=size)
+    return sp.csr_matrix((data, indices, indptr), shape=(mesh.n_dof, mesh.n_dof))
 
 
 #: free DOFs up to which a frame's modes come from the dense solve: a speed choice, not a

@@ -159,6 +159,49 @@ def test_a_section_loss_adds_exactly_its_mass():
                                                 rel=1e-12)
 
 
+def test_kept_members_and_patterns_assemble_what_a_plain_sum_does():
+    """frame_matrices keeps each member's elements and each mesh's sparse pattern between
+    models: K and M equal, to rounding, the sum built here entry by entry from the element
+    matrices, springs and masses of the model at hand, whichever models came before (a
+    member changed by its crack, one left as it was, springs of other values)."""
+    from gfe_opt.frame import element_matrices
+    from gfe_opt.frame_data import build_observation
+
+    base = portal_frame(7)
+    first = base.with_effects([
+        Effect("crack", {"member": "left-column", "position": 0.11, "depth_ratio": 0.3}),
+        Effect("joint_spring", {"node": "C", "member": "beam", "stiffness": 3000.0}),
+        Effect("support_spring", {"node": "D", "stiffness": 9000.0})])
+    second = base.with_effects([
+        Effect("crack", {"member": "left-column", "position": 0.17, "depth_ratio": 0.3}),
+        Effect("joint_spring", {"node": "C", "member": "beam", "stiffness": 1200.0}),
+        Effect("support_spring", {"node": "D", "stiffness": 20000.0}),
+        Effect("point_mass", {"member": "beam", "position": 0.1, "mass": 0.05})])
+    frame_matrices(first)
+    K, M = frame_matrices(second)
+    mesh = frame_mesh(second)
+    Ke, Me = element_matrices(second)
+    K_sum, M_sum = np.zeros(K.shape), np.zeros(M.shape)
+    for dofs, k, m in zip(mesh.element_dofs, Ke, Me):
+        K_sum[np.ix_(dofs, dofs)] += k
+        M_sum[np.ix_(dofs, dofs)] += m
+    for a, b, k in mesh.springs:
+        K_sum[np.ix_([a, b], [a, b])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    for dof, k in mesh.grounded:
+        K_sum[dof, dof] += k
+    assert [k for *_, k in mesh.springs] == [1200.0] and mesh.grounded[0][1] == 20000.0
+    C = build_observation(second, mesh, [{"member": "beam", "position": 0.1, "direction": d}
+                                         for d in ("x", "y")]).toarray()
+    M_sum += 0.05 * C.T @ C
+    assert np.max(np.abs(K.toarray() - K_sum)) <= 1e-14 * np.max(np.abs(K_sum))
+    assert np.max(np.abs(M.toarray() - M_sum)) <= 1e-14 * np.max(np.abs(M_sum))
+    # the crack moved: the left column's elements differ, the beam's are the kept ones
+    Ke_first, _ = element_matrices(first)
+    column = mesh.element_member == 0
+    assert not np.array_equal(Ke_first[column], Ke[column])
+    assert np.array_equal(Ke_first[~column], Ke[~column])
+
+
 def test_a_one_member_frame_is_the_beam_with_its_crack():
     """A vertical column clamped at its base is the package's cantilever beam: the same
     bending frequencies with the same Christides–Barr crack (to 5e-9: the beam integrates
