@@ -262,6 +262,40 @@ def test_a_stiffer_zone_of_the_beam_is_a_section_loss_there(start, end, ratio, s
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
+def test_each_member_as_long_as_the_best_one_is_fitted_again_from_the_best_place():
+    """The best member's local effect, as found, starts the fit on every other member of its
+    length (its distance from the start node, its length and sizes): a member whose own
+    grid ended in a valley of its own (a portal's left column, whose zone near its foot was
+    fitted at its top, while the right column's foot fitted better) is fitted again from
+    the place its mirror image holds.  Members of another length, the best member itself
+    and effects without a place along a member get no such start; a value the user gave
+    stays."""
+    from types import SimpleNamespace
+
+    from gfe_opt.diagnosis import _same_place_elsewhere
+
+    model = portal_frame()
+    found = {"position": 0.0543, "length": 0.0111, "stiffness_ratio": 3.0, "mass_ratio": 1.29}
+
+    def fit(member, **params):
+        return SimpleNamespace(added=0, effects=(Effect("section_loss", {
+            "member": member, **params}),))
+
+    best = fit("right-column", **found)
+    fits = [fit("left-column", position=0.287, length=0.026, stiffness_ratio=0.97,
+                mass_ratio=0.53), fit("beam", position=0.39, length=0.009,
+                                      stiffness_ratio=1.2, mass_ratio=0.05), best]
+    assert _same_place_elsewhere(model, best, fits) == [
+        (0, {"member": "left-column", **found})]
+    assert _same_place_elsewhere(model, best, fits, {"mass_ratio": 1.0}) == [
+        (0, {"member": "left-column", **found, "mass_ratio": 1.0})]
+    beam = fits[1]
+    assert _same_place_elsewhere(model, beam, fits) == []   # no other member is as long
+    joint = SimpleNamespace(added=0, effects=(Effect("joint_spring", {
+        "node": "B", "member": "beam", "stiffness": 2000.0}),))
+    assert _same_place_elsewhere(model, joint, [joint, fits[0]]) == []
+
+
 @pytest.mark.slow   # the told trade's mechanism: tests/test_fitting_numerics.py
 def test_a_zone_shorter_than_the_modes_resolve_is_named_by_its_compliance():
     """2 cm of the right column (7 % of it) twice as stiff, at 1.7 times the usual noise
