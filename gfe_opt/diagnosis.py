@@ -1596,10 +1596,14 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
 
 
 def traded_note(fit) -> str:
-    """What a fit whose parameters trade as its effect allows (:attr:`Fit.traded`) tells."""
-    return (f"{fit.name}: " + "; ".join(fit.traded) + ": the data fix their combination (a "
-            "zone's added compliance ℓ (1/r − 1) and mass ℓ (m − 1)), not each value; each ± "
-            "is taken along that trade")
+    """What a fit whose parameters trade as its effect allows (:attr:`Fit.traded`) tells:
+    the combinations the data fix, with their σ (:attr:`Fit.told`, the JSON's ``told``)."""
+    told = fit.told[fit.added] if fit.added is not None and fit.told else {}
+    said = "; ".join(f"{t['label']} = {t['value']:.3g} ± {t['sigma']:.2g} {t['unit']}"
+                     for t in told.values())
+    return (f"{fit.name}: " + "; ".join(fit.traded) + ": the data fix their combination ("
+            + (said or "a zone's added compliance ℓ (1/r − 1) and mass ℓ (m − 1)")
+            + "), not each value; each ± is taken along that trade")
 
 
 def drop_indices(model: Model, drop) -> set:

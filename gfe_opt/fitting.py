@@ -362,6 +362,10 @@ class Fit:
     #: trades the effect declares a finding (on a frame a short zone: its length against
     #: its ratios; the data fix the combination, not each value): sentences
     traded: list = field(default_factory=list)
+    #: per effect, the combinations of its parameters it declares the data fix
+    #: (:meth:`~gfe_opt.effects.base.EffectType.told_values`; a frame zone's added bending
+    #: compliance and mass): {key: {"label", "unit", "value", "sigma"}}
+    told: tuple = ()
     #: per effect, parameters that ended on a bound of their range: {key: "at least" |
     #: "at most"} (the data tell one side only)
     bounds: tuple = ()
@@ -410,6 +414,8 @@ class Fit:
                 "equivalent": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
                                 for e in effects] for effects in self.equivalent],
                 "not_estimable": list(self.unidentified), "traded": list(self.traded),
+                "told": jsonable(self.told[self.added]) if self.added is not None
+                and self.told else {},
                 "bounds": added["bounds"]}
 
 
@@ -643,15 +649,16 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     fitted = base.with_effects(effects, check=False)
     fit_misfit = misfit(fitted, measured, noise, C)
     saturated = _saturated(slots, z, lower, upper)
-    sigma, unidentified, traded = _uncertainty(residual, z, slots, base, fit_misfit, lower,
-                                               upper, saturated)
+    sigma, unidentified, traded, told = _uncertainty(residual, z, slots, base, fit_misfit,
+                                                     lower, upper, saturated)
     added = [i for i, s in enumerate(slots) if s.added]
     return Fit(name=name or (slots[added[0]].effect.name if added else "baseline"),
                effects=tuple(effects), sigma=tuple(sigma), added=added[0] if added else None,
                model=fitted, misfit=fit_misfit, n_params=z.size, status=status,
                success=success and np.isfinite(fit_misfit.chi2), evaluations=residual.count,
                equivalent=[tuple(effects_of(e)) for e in equivalent],
-               unidentified=unidentified, traded=traded, bounds=tuple(saturated))
+               unidentified=unidentified, traded=traded, told=tuple(told),
+               bounds=tuple(saturated))
 
 
 #: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
@@ -977,7 +984,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     n = z.size
     out = [{} for _ in slots]
     if n == 0 or not np.isfinite(fit_misfit.chi2):
-        return out, [], []
+        return out, [], [], [{} for _ in slots]
     held = np.array([v.key in marks for marks, slot in zip(saturated or [{}] * len(slots),
                                                              slots) for v in slot.variables],
                     dtype=bool)
@@ -1086,7 +1093,45 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     # length spans it), any other undetermines the effect
     for j, key, sentence in wide.values():
         (traded if (j, key) in in_trade else unidentified).append(sentence)
-    return out, unidentified, traded
+    finite = np.where(np.isfinite(cov), cov, 0.0) if T is None else cov_z
+    return out, unidentified, traded, _told(slots, base, z, finite, held)
+
+
+def _told(slots, base, z, cov_z, held) -> list[dict]:
+    """Per slot, the combinations of its parameters its effect declares the data fix
+    (:meth:`~gfe_opt.effects.base.EffectType.told_values`) with their σ: √(gᵀ Σ g), g their
+    gradient in the order-one variables (central differences of the physical values), Σ
+    the variables' covariance.  A held variable's direction carries nothing."""
+    out, i = [], 0
+    for slot in slots:
+        k = len(slot.variables)
+        told_values = getattr(slot.effect, "told_values", None)
+        zs = z[i:i + k]
+
+        def values(zz, slot=slot, told_values=told_values):
+            params = {**slot.fixed, **{v.key: v.physical(base, x)
+                                       for v, x in zip(slot.variables, zz)}}
+            return told_values(base, params)
+
+        told = values(zs) if told_values is not None and k and all(
+            v.index is None for v in slot.variables) else {}
+        entry = {}
+        for key, (label, unit, value) in told.items():
+            g = np.zeros(k)
+            for a in range(k):
+                if held[i + a]:
+                    continue
+                h = 1e-6 * max(1.0, abs(zs[a]))
+                up, down = zs.copy(), zs.copy()
+                up[a] += h
+                down[a] -= h
+                g[a] = (values(up)[key][2] - values(down)[key][2]) / (2 * h)
+            block = cov_z[i:i + k, i:i + k]
+            entry[key] = {"label": label, "unit": unit, "value": float(value),
+                          "sigma": float(np.sqrt(max(float(g @ block @ g), 0.0)))}
+        out.append(entry)
+        i += k
+    return out
 
 
 #: the parameter a tied direction moves (:meth:`EffectType.tie`: a zone's inner edge, its

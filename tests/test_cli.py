@@ -126,8 +126,9 @@ def test_diagnose_json_contract(files, capsys):
         assert set(entry) == {"effect", "parameters", "uncertainty", "freq_error_rms_pct",
                               "mac_mean", "chi2_per_residual", "significant",
                               "mirror_position", "equivalent", "not_estimable", "traded",
-                              "bounds"}
+                              "told", "bounds"}
         assert entry["traded"] == []   # a beam's parameters never trade as a finding
+        assert entry["told"] == {}     # nor does a beam's effect declare told values
         assert all(v in ("at_least", "at_most") for v in entry["bounds"].values())
         assert set(entry["uncertainty"]) <= set(entry["parameters"])
     first = data["effects"][0]

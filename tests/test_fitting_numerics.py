@@ -130,7 +130,7 @@ def test_mode_sign_follows_the_first_of_equal_peaks():
 
 def _two_parameter_slot(told=()):
     """A stand-in for one added effect with two 'positive' parameters a and b (``told``:
-    the trades it declares a finding)."""
+    the trades it declares a finding; it then declares their product told)."""
     from types import SimpleNamespace
 
     from gfe_opt.effects.base import Parameter, Variable
@@ -138,21 +138,27 @@ def _two_parameter_slot(told=()):
     params = {k: Parameter(k, "-", "positive", k) for k in ("a", "b")}
     effect = SimpleNamespace(name="toy", parameter=params.__getitem__,
                              tie=lambda model, variables, z: None,
-                             told_trades=lambda model: told)
+                             told_trades=lambda model: told,
+                             told_values=lambda model, p: {"ab": ("a b", "-", p["a"] * p["b"])}
+                             if told else {})
     variables = [Variable(k, 0.01, 10.0, (1.0,)) for k in ("a", "b")]
-    return [SimpleNamespace(effect=effect, variables=variables, added=True)]
+    return [SimpleNamespace(effect=effect, variables=variables, added=True, fixed={})]
 
 
-def _sigma_of(residual, z, told=()):
-    """σ and the not-estimable sentences (with ``told``, also the told trades')."""
+def _sigma_of(residual, z, told=(), values=False):
+    """σ and the not-estimable sentences (with ``told``, also the told trades'; with
+    ``values``, also the told values)."""
     from types import SimpleNamespace
 
     from gfe_opt.fitting import _uncertainty
 
     r = residual(z)
     misfit = SimpleNamespace(chi2=float(r @ r), n_residuals=r.size)
-    sigma, unidentified, traded = _uncertainty(residual, z, _two_parameter_slot(told), None,
-                                               misfit, np.full(2, 0.01), np.full(2, 10.0))
+    sigma, unidentified, traded, said = _uncertainty(residual, z, _two_parameter_slot(told),
+                                                     None, misfit, np.full(2, 0.01),
+                                                     np.full(2, 10.0))
+    if values:
+        return sigma, said
     return (sigma, unidentified, traded) if told else (sigma, unidentified)
 
 
@@ -197,3 +203,19 @@ def test_a_trade_the_effect_declares_a_finding_is_told_not_inestimable():
     assert unidentified == [], unidentified
     assert any("trade against each other" in t for t in traded), traded
     assert any("exceeds its value" in t for t in traded), traded
+
+
+def test_the_combination_a_trade_leaves_told_has_the_sigma_the_data_give_it():
+    """In the valley where only a·b = 2 is measured (to 1e-3: its residual's weight), the
+    effect's told value a·b is 2 with σ 1e-3 (the linear σ of what is measured), while a
+    alone has a σ above its value: the combination is what the output can say."""
+    def residual(z):
+        return np.array([1e3 * (z[0] * z[1] - 2.0), 0.002 * (z[0] - 1.0),
+                         0.002 * (z[1] - 2.0)])
+
+    sigma, said = _sigma_of(residual, np.array([1.0, 2.0]), told=(frozenset(("a", "b")),),
+                            values=True)
+    assert sigma[0]["a"] > 1.0
+    ab = said[0]["ab"]
+    assert ab["value"] == pytest.approx(2.0, rel=1e-12)
+    assert ab["sigma"] == pytest.approx(1e-3, rel=0.05)

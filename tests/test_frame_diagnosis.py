@@ -321,7 +321,17 @@ def test_a_zone_shorter_than_the_modes_resolve_is_named_by_its_compliance():
         (b - a) * (1 / ratio - 1), rel=0.1)
     entry = next(e for e in d.to_json()["effects"] if e["effect"] == "section_loss")
     assert entry["traded"] and not entry["not_estimable"]
-    assert any("the data fix their combination" in n for n in d.notes), d.notes
+    # the compliance the data fix, within 3 of its σ of the truth's, told in the note too
+    column = model.member("right-column")
+    told = entry["told"]["compliance"]
+    truth = (b - a) * (1 / ratio - 1) / (column.E * column.inertia)
+    assert abs(told["value"] - truth) < 3 * told["sigma"] and told["unit"] == "rad/(N m)"
+    # determined (2 σ from nothing) while the length alone is not (σ above its value)
+    assert told["sigma"] < 0.5 * abs(told["value"])
+    assert entry["uncertainty"]["length"] > entry["parameters"]["length"]
+    assert any("the data fix their combination (added bending compliance" in n
+               and f"{told['value']:.3g} ± {told['sigma']:.2g} rad/(N m)" in n
+               for n in d.notes), d.notes
     after = update(model, measured, d.add_arguments(), **noise)
     assert diagnose(after.model, measured, **noise).verdict == "consistent"
 

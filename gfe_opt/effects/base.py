@@ -342,6 +342,12 @@ class EffectType:
         estimable."""
         return ()
 
+    def told_values(self, model, params: dict) -> dict:
+        """The combinations of the parameters the data fix when a trade of
+        :meth:`told_trades` leaves each value loose: {key: (label, unit, value)} (the fit
+        gives each its σ, :attr:`~gfe_opt.fitting.Fit.told`).  None by default."""
+        return {}
+
     def check(self, model, params: dict, where: str, prefix: str) -> None:
         """Checks across parameters or against the model (override when needed)."""
 

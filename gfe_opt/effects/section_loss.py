@@ -73,6 +73,20 @@ class SectionLoss(EffectType):
         keys = ("length", "stiffness_ratio", "mass_ratio")
         return tuple(frozenset((a, b)) for i, a in enumerate(keys) for b in keys[i + 1:])
 
+    def told_values(self, model, params):
+        """On a frame, what a zone's trade leaves told: its added bending compliance
+        ∫ (1/EI − 1/EI₀) dx = ℓ (1/r − 1)/EI₀ [rad/(N m)] and its added mass
+        ρA ℓ (m − 1) [kg] (EI₀, ρA its member's)."""
+        if model.kind != "frame" or "member" not in params:
+            return {}
+        member = model.member(params["member"])
+        ell = params["length"]
+        ei0 = model.stiffness_factor * member.E * member.inertia
+        return {"compliance": ("added bending compliance ℓ (1/r − 1)/EI", "rad/(N m)",
+                               ell * (1.0 / params["stiffness_ratio"] - 1.0) / ei0),
+                "mass": ("added mass ρA ℓ (m − 1)", "kg",
+                         member.rho * member.area * ell * (params["mass_ratio"] - 1.0))}
+
     def check(self, model, params, where, prefix):
         if "length" in params and params["length"] > model.length:
             raise GfeInputError(where, f"{prefix}length", f"{params['length']:g} m is longer "
