@@ -366,25 +366,31 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
     parameters the user fixed as starting values; ``extra`` effects are added first
     (lookahead pairs); from frequencies alone IPOPT then runs from every start, ``seeds``
     (the candidate's own fit alone) and profile starts included: two effects that trade
-    against each other (a soft clamp, a tip mass) are found only by moving both."""
+    against each other (a soft clamp, a tip mass) are found only by moving both.  On a
+    frame each member as long as the best one is fitted again from the best one's place
+    (:func:`_same_place_elsewhere`); with the member given (``update --add
+    section_loss:member=left-column``), the other members of its length are fitted too, as
+    the places it is fitted again from, so that ``update`` ends where ``diagnose`` did."""
     kind = effect_type(name)
-    groups = {}  # starts that share their fixed parameters: one fit, the best start wins
-    for start in [*kind.starts(model, hint), *seeds]:
-        start = {**start, **(given or {})}
-        key = repr({k: start.get(k) for k in kind.fixed_keys()})
-        if start not in groups.setdefault(key, []):
-            groups[key].append(start)
-    best, fits = None, []
-    for starts in groups.values():
-        fit = fit_effects(model, measured, [*extra, Effect(name, starts[0])], noise=noise,
-                          name=name, alternatives=starts[1:],
-                          multistart=True if (extra or thorough) and measured.frequency_only
-                          else "auto")
-        fits.append(fit)
-        if best is None or _preferred(fit, best):
+    fits = _fit_groups(model, measured, name, noise, kind.starts(model, hint), given, extra,
+                       seeds, thorough)
+    best = fits[0]
+    for fit in fits[1:]:
+        if _preferred(fit, best):
             best = fit
     if model.kind == "frame" and not extra:
-        for i, start in _same_place_elsewhere(model, best, fits, given):
+        source, member = best, (given or {}).get("member")
+        along = any(p.name == "position" for p in kind.parameters)   # a place on it
+        if member is not None and along and "position" not in given:
+            length = model.member_length(model.member(member))
+            for m in model.members:
+                if m.id != member and abs(model.member_length(m) - length) <= 1e-9 * length:
+                    for fit in _fit_groups(model, measured, name, noise,
+                                           kind.starts(model, hint), {**given, "member": m.id},
+                                           extra, seeds, thorough):
+                        if _preferred(fit, source):
+                            source = fit
+        for i, start in _same_place_elsewhere(model, source, fits, given):
             fit = fit_effects(model, measured, [Effect(name, start)], noise=noise, name=name)
             if _preferred(fit, fits[i]):
                 fits[i] = fit
@@ -396,6 +402,24 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
         best.other_places = [(f.effects, f.misfit.chi2) for f in fits
                              if f is not best and f.success]
     return best
+
+
+def _fit_groups(model, measured, name, noise, starts, given, extra, seeds, thorough) -> list:
+    """One fit per group of ``starts`` (and ``seeds``, with ``given`` over each) that share
+    their fixed parameters (a frame's member): the group's first start and its others as
+    alternatives (the best grid point over them starts IPOPT)."""
+    kind = effect_type(name)
+    groups = {}
+    for start in [*starts, *seeds]:
+        start = {**start, **(given or {})}
+        key = repr({k: start.get(k) for k in kind.fixed_keys()})
+        if start not in groups.setdefault(key, []):
+            groups[key].append(start)
+    return [fit_effects(model, measured, [*extra, Effect(name, group[0])], noise=noise,
+                        name=name, alternatives=group[1:],
+                        multistart=True if (extra or thorough) and measured.frequency_only
+                        else "auto")
+            for group in groups.values()]
 
 
 def _fit_without(model, measured, noise, index):

@@ -296,6 +296,36 @@ def test_each_member_as_long_as_the_best_one_is_fitted_again_from_the_best_place
     assert _same_place_elsewhere(model, joint, [joint, fits[0]]) == []
 
 
+@pytest.mark.slow   # the rule's mechanism: the test above
+def test_update_at_a_named_member_ends_where_the_diagnosis_did(monkeypatch):
+    """The frame campaign's zone-3417, rebuilt here (3.3 cm of the left column, 5 to 8 cm
+    above its base, 1.45 times as stiff; 1.42 times the usual noise, its measurement seed):
+    the left column's own grid ends at the column's top; the diagnosis found the zone from
+    the right column's place.  ``update --add section_loss:member=left-column`` (as the
+    diagnosis prints it) fits the right column too and starts the left one from its place:
+    the zone at its centre (within 2 % of the column), then consistent.  Without the start
+    from the other column the update ends at the column's top."""
+    from gfe_opt import diagnosis
+
+    model = portal_frame()
+    a, b, ratio = 0.04968723017791041, 0.08281547959797414, 1.4524548838899691
+    exact, where = zone_frame(model, "left-column", a, b, ratio, ratio ** (1 / 3))
+    bracket = [Effect("section_loss", {"member": "left-column", "position": (a + b) / 2,
+                                       "length": b - a, "stiffness_ratio": ratio,
+                                       "mass_ratio": ratio ** (1 / 3)})]
+    noise = {k: 1.4165071946211496 * v for k, v in NOISE.items()}
+    measured = _measured(model, exact, _guess(model, bracket), _sensors(model), 1932420502,
+                         where, noise)
+    args = ["section_loss:member=left-column"]
+    after = update(model, measured, args, **noise)
+    zone = after.model.effects[0].parameters
+    assert abs(zone["position"] - (a + b) / 2) < 0.02 * 0.3, zone
+    assert diagnose(after.model, measured, **noise).verdict == "consistent"
+    monkeypatch.setattr(diagnosis, "_same_place_elsewhere", lambda *args: [])
+    alone = update(model, measured, args, **noise).model.effects[0].parameters
+    assert alone["position"] > 0.2, alone          # the column's top: its own valley
+
+
 @pytest.mark.slow   # the told trade's mechanism: tests/test_fitting_numerics.py
 def test_a_zone_shorter_than_the_modes_resolve_is_named_by_its_compliance():
     """2 cm of the right column (7 % of it) twice as stiff, at 1.7 times the usual noise
