@@ -451,12 +451,11 @@ def _not_needed(model, reference, without, sel) -> list[dict]:
 def _same_place_elsewhere(model, best, fits, given=None) -> list[tuple[int, dict]]:
     """On a frame, a start for each other member's fit of a local effect: the best fit's
     effect as found (its distance from the start node, its length and sizes) on each
-    member as long as the best one's, unless that member's fit is already as good.  Its
+    member as long as the best one's (the fit from it is kept where it ends lower).  Its
     own grid may leave such a member at a valley of its own while the effect sits at the
     place the best member's mirror image holds: a symmetric portal's stiffer zone near the
     left column's foot was fitted at that column's top (χ²/n 1.74) and found on the right
-    column's foot (1.52), from the right column's place 1.03 (the held-out zone-3417), so
-    that no note said the two columns could not be told apart."""
+    column's foot (1.52), from the right column's place 1.03 (the held-out zone-3417)."""
     placed = best.effects[best.added].parameters if best.added is not None else {}
     if "member" not in placed or "position" not in placed:
         return []
