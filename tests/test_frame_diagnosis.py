@@ -80,6 +80,8 @@ def test_no_false_alarm_on_a_portal_that_is_as_modelled(seed):
     assert d.verdict == "consistent", d.notes
 
 
+@pytest.mark.slow   # 52 s; the frame campaign's `joints` class and the README's semi-rigid
+# portal (scripts/check_readme.py) run the same loop
 def test_two_semirigid_joints_are_found_at_their_joints_and_then_the_portal_agrees():
     """The beam tied to both columns through 2000 N m/rad (the portal's 4EI/L is 9 000):
     with the noise not stated, the diagnosis suggests a joint spring at B and one at C
@@ -193,6 +195,7 @@ def test_a_clamp_that_gives_is_a_support_spring_at_its_node():
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
+@pytest.mark.slow   # 23 s; the frame campaign's `crack` class (any member, 15-85 % along it)
 def test_a_crack_near_a_column_base_is_found_on_that_column_at_its_place():
     """Another crack law than the package's: the exact frame's left column is two members
     joined at 0.06 m by a rotational line spring of 46 000 N m/rad (about a/h 0.3 of a

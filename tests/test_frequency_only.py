@@ -104,6 +104,8 @@ def test_a_cracks_mirror_image_is_named_not_guessed(start):
     assert any("mirror" in n for n in d.notes), d.notes
 
 
+@pytest.mark.slow   # 40 s: the suite's 10 minutes; a frequency-only diagnosis runs in
+# test_a_cracks_mirror_image_is_named_not_guessed
 def test_frequency_only_cantilever_loop_ends_without_a_crack():
     """Ten frequencies of a cantilever whose clamp gives and which carries a tip mass: the
     loop (diagnose, add what it suggests, again) never adds a crack and never raises the
