@@ -796,18 +796,7 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T)
 
 
-def bending_parameters(model: FrameModel, mesh: FrameMesh | None = None) -> np.ndarray:
-    """(n_el, 3): k_ww, k_wθ, k_θθ of every element [N m²], member by member
-    (:func:`_member_bending`)."""
-    return np.concatenate([m.bending for m in member_elements(model)])
-
-
-def axial_rigidity(model: FrameModel, mesh: FrameMesh | None = None) -> np.ndarray:
-    """(n_el,): EA of every element [N], member by member (:func:`_member_axial`)."""
-    return np.concatenate([m.axial for m in member_elements(model)])
-
-
-def element_matrices(model: FrameModel, mesh: FrameMesh | None = None):
+def element_matrices(model: FrameModel):
     """(K_e, M_e), each (n_el, 6, 6) in global axes: bar ⊕ beam in the member's axes,
     rotated by T = diag(R, R)."""
     members = member_elements(model)
@@ -984,8 +973,9 @@ def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:
     v1, v2 = -s * u[:, 0] + c * u[:, 1], -s * u[:, 3] + c * u[:, 4]
     d1 = v1 - v2 + L * u[:, 5]                            # d = H [w1, Lθ1, w2, Lθ2]
     d2 = L * (u[:, 2] - u[:, 5])
-    p = bending_parameters(model, mesh)
-    EA = axial_rigidity(model, mesh)
+    members = member_elements(model)
+    p = np.concatenate([m.bending for m in members])
+    EA = np.concatenate([m.axial for m in members])
     energy = (EA[:, None] / L) * axial**2 + (p[:, 0, None] * d1**2 + 2 * p[:, 1, None] * d1 * d2
                                              + p[:, 2, None] * d2**2) / L**3
     total = energy.sum(axis=0)
