@@ -704,7 +704,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     jobs, labels, skipped, fallback_names = [], [], [], []
     for name in names:
         kind = effect_type(name)
-        if not kind.local and any(e.name == name for e in model.effects):
+        if not kind.is_local(model) and any(e.name == name for e in model.effects):
             continue  # present: re-estimated in every fit
         if any(e.name in kind.redundant_with for e in model.effects):
             continue  # held by an effect present (E with a stiffness profile)
@@ -1022,7 +1022,7 @@ def _swap(model, measured, noise, reference, names, sel):
     best = None
     for i, effect in enumerate(reference.effects):
         kind = effect_type(effect.name)
-        edges = _on_edge(model, effect) if kind.local else []
+        edges = _on_edge(model, effect) if kind.is_local(model) else []
         if not edges:
             continue
         rest = [e for j, e in enumerate(reference.effects) if j != i]
@@ -1033,8 +1033,8 @@ def _swap(model, measured, noise, reference, names, sel):
         alts = []
         for name in names:
             other = effect_type(name)
-            if name == effect.name or not other.local or getattr(other, "fallback", False) \
-                    or not other.starts(base, hint):
+            if name == effect.name or not other.is_local(base) \
+                    or getattr(other, "fallback", False) or not other.starts(base, hint):
                 continue
             try:
                 check_enough_modes(measured, [*rest, Effect(name, {})])
@@ -1186,7 +1186,8 @@ def _pairs_with(model, measured, noise, best, fits, hint, explains, sel):
     others = [f for f in (fits[i] for i in ranked([f.misfit.chi2 for f in fits]))
               if f is not best and (not f.failed or not f.success) and f.name != best.name
               and not getattr(effect_type(f.name), "fallback", False)]
-    seconds = ([best.name] if effect_type(best.name).local else []) + [f.name for f in others]
+    seconds = ([best.name] if effect_type(best.name).is_local(model) else []) + \
+        [f.name for f in others]
     first = Effect(best.name, best.parameters)
     alone = {f.name: f.parameters for f in others}
     jobs = [("candidate", (model, measured, name, noise, hint, None, (first,),
@@ -1562,11 +1563,12 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     for e in effects:
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
                                      partial=True)
-    check_repeats([*model.effects, *effects], "--add", "effects")
-    if model.kind == "frame":   # one joint spring a member end, as in a frame file
+    if model.kind == "frame":   # one joint spring, one axial load a member end, as in a file
         from .frame import check_repeats as check_frame_repeats
 
         check_frame_repeats([*model.effects, *effects], "--add")
+    else:
+        check_repeats([*model.effects, *effects], "--add", "effects")
     check_enough_modes(measured, [*model.effects, *effects])
     hint = None
     starts = []

@@ -41,11 +41,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import elements as el
+from .effects.axial_load import slope_gram
 from .errors import GfeInputError
 
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
-                 "point_mass", "axial_stiffness", "material", "section_loss")
+                 "point_mass", "axial_stiffness", "material", "section_loss", "axial_load")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -328,6 +329,10 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
         return _as_effect({"effect": name, "member": member_id, "ratio": ratio})
     if name == "section_loss":
         return _section_loss(model, member, raw, where, prefix)
+    if name == "axial_load":
+        no_unknown(raw, {"effect", "member", "tension"}, where, prefix)
+        return _as_effect({"effect": name, "member": member_id,
+                           "tension": _number(raw, "tension", where, prefix=prefix)})
     if name == "crack":
         no_unknown(raw, {"effect", "member", "position", "depth_ratio"}, where, prefix)
         length = model.member_length(member)
@@ -443,7 +448,7 @@ def _as_effect(raw: dict):
 
 def check_repeats(effects, where) -> None:
     """One joint spring a member end, one support effect a node and direction, one axial
-    stiffness a member, one material."""
+    stiffness and one axial load a member, one material."""
     seen = {}
     for i, e in enumerate(effects):
         key = _effect_key(e)
@@ -460,8 +465,8 @@ def _effect_key(effect) -> tuple | None:
         return None
     if e["effect"] == "material":
         return ("material",)
-    if e["effect"] == "axial_stiffness":
-        return ("axial_stiffness", e["member"]) if "member" in e else None
+    if e["effect"] in ("axial_stiffness", "axial_load"):
+        return (e["effect"], e["member"]) if "member" in e else None
     if "node" not in e:
         return None   # --add without a place: every place is tried
     if e["effect"] == "joint_spring":
@@ -638,18 +643,20 @@ def _zoned_elements(zones, step: float, count: int) -> list[int]:
 
 #: the effects that change a member's elements (the others act at joints, supports and
 #: places: springs, masses, applied in :func:`frame_matrices`)
-_ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness")
+_ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness", "axial_load")
 
 
 @dataclass(frozen=True)
 class MemberElements:
     """One member's elements: bending parameters k_ww, k_wθ, k_θθ (n, 3) [N m²], axial
-    rigidity EA (n,) [N], stiffness and mass matrices (n, 6, 6) in global axes."""
+    rigidity EA (n,) [N], stiffness and mass matrices (n, 6, 6) in global axes (the
+    stiffness with the geometric stiffness of the member's ``tension``, N, > 0 pulling)."""
 
     bending: np.ndarray
     axial: np.ndarray
     K: np.ndarray
     M: np.ndarray
+    tension: float = 0.0
 
 
 #: members' elements computed, by everything that decides them (:func:`_member_key`): a fit
@@ -788,12 +795,22 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     mass = (rhoA * L)[:, None, None] * el.symmetric_beam_mass(
         **{key: np.full(n, v) for key, v in el.CONSISTENT_BEAM_MASS.items()})
     local_m[np.ix_(range(n), bend, bend)] = mass * scaling[:, :, None] * scaling[:, None, :]
+    tension = _member_tension(model, member)
+    if tension:   # geometric stiffness T ∫ N'ᵀN' dx of the transverse motion
+        local_k[np.ix_(range(n), bend, bend)] += tension * slope_gram(L[0]) \
+            * scaling[:, :, None] * scaling[:, None, :]
     zones = _zones(model, member.id)
     for j, start, x, w in _zoned_quadrature(zones, L[0], n):
         local_m[j] += _zone_mass(zones, rhoA[j], start, L[0], x, w)
     T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
     Tt = np.swapaxes(T, 1, 2)
-    return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T)
+    return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension)
+
+
+def _member_tension(model: FrameModel, member: Member) -> float:
+    """The axial force of an ``axial_load`` on ``member`` [N] (tension > 0), else 0."""
+    return float(next((e["tension"] for e in model.raw_effects
+                       if e["effect"] == "axial_load" and e["member"] == member.id), 0.0))
 
 
 def element_matrices(model: FrameModel):
@@ -978,6 +995,11 @@ def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:
     EA = np.concatenate([m.axial for m in members])
     energy = (EA[:, None] / L) * axial**2 + (p[:, 0, None] * d1**2 + 2 * p[:, 1, None] * d1 * d2
                                              + p[:, 2, None] * d2**2) / L**3
+    T = np.concatenate([np.full(m.axial.size, m.tension) for m in members])
+    if np.any(T):   # a member's axial load: T ∫ w'² dx, w' from [v₁, Lθ₁, v₂, Lθ₂]
+        q = np.stack([v1, L * u[:, 2], v2, L * u[:, 5]], axis=1)      # (n_el, 4, modes)
+        gram = slope_gram(1.0) * 30.0                                  # 30 L ∫ N'ᵀN' (scaled)
+        energy = energy + (T[:, None] / (30.0 * L)) * np.einsum("eim,ij,ejm->em", q, gram, q)
     total = energy.sum(axis=0)
     for a, b, k in mesh.springs:
         total = total + k * (shapes[a] - shapes[b]) ** 2

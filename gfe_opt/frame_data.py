@@ -539,8 +539,8 @@ def effect_place(model: FrameModel, effect) -> str:
 def _mark(model: FrameModel, name: str, params: dict):
     """(name, (x, y), label, member polyline or None) of an effect found on a frame: a crack
     or a mass at its place on its member, a joint spring just off its joint along its
-    member (which member end turns), a support effect at its node, an axial stiffness along
-    its member, a material along every member, a section loss over its zone."""
+    member (which member end turns), a support effect at its node, an axial stiffness or load
+    along its member, a material along every member, a section loss over its zone."""
     def along(member_id, t):
         m = model.member(member_id)
         (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]

@@ -493,11 +493,12 @@ def frame_localisation(members, points, residual, worst, labels):
     return fig
 
 
-#: how each effect found is marked on a frame: marker and colour (an axial stiffness is its
-#: member drawn over in colour)
+#: how each effect found is marked on a frame: marker and colour (an axial stiffness or
+#: load is its member drawn over in colour)
 FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "support_spring": ("D", "tab:brown"), "support_translation": ("D", "tab:brown"),
-               "point_mass": ("s", "tab:purple"), "axial_stiffness": (None, "tab:blue")}
+               "point_mass": ("s", "tab:purple"), "axial_stiffness": (None, "tab:blue"),
+               "axial_load": (None, "tab:cyan")}
 
 
 def frame_findings(members, marks, failing, title):

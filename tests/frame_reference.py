@@ -9,6 +9,12 @@ F₂ = −EI w‴(L), M₂ = EI w″(L)), so the member's dynamic stiffness is F
 assembled as a stiffness matrix, D(ω) is singular at every natural frequency.  A root is
 found by bisection of the eigenvalue of D(ω) (in a fixed place of the sorted spectrum) that
 crosses zero, in a bracket about an estimate.
+
+A member may carry a constant axial force T (tension > 0; a seventh entry of its tuple):
+EI w⁗ − T w″ = ρAω² w, whose solutions are cos βx, sin βx, cosh αx, sinh αx with α², −β²
+the roots of EI s² − T s − ρAω² = 0, and whose transverse end forces gain T w′
+(F₁ = EI w‴(0) − T w′(0), F₂ = −EI w‴(L) + T w′(L)).  :func:`self_stress` gives the forces
+a member's prestrain (a turnbuckle) sets up in a frame, by the exact static stiffness.
 """
 
 from __future__ import annotations
@@ -21,8 +27,16 @@ from scipy.optimize import brentq
 SUPPORTS = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 
 
-def member_dynamic_stiffness(E, rho, A, inertia, L, omega) -> np.ndarray:
-    """(6, 6) dynamic stiffness in the member's axes, DOFs u₁, v₁, θ₁, u₂, v₂, θ₂."""
+def _wavenumbers(E, rho, A, inertia, omega, tension=0.0):
+    """(β, α) of a member's transverse motion at ω: w = cos βx, sin βx, cosh αx, sinh αx."""
+    EI = E * inertia
+    root = math.sqrt(tension**2 + 4.0 * EI * rho * A * omega**2)
+    return math.sqrt((root - tension) / (2 * EI)), math.sqrt((root + tension) / (2 * EI))
+
+
+def member_dynamic_stiffness(E, rho, A, inertia, L, omega, tension=0.0) -> np.ndarray:
+    """(6, 6) dynamic stiffness in the member's axes, DOFs u₁, v₁, θ₁, u₂, v₂, θ₂ (with a
+    constant axial force ``tension``, N)."""
     D = np.zeros((6, 6))
     k = omega * math.sqrt(rho / E)
     if k * L < 1e-8:
@@ -32,21 +46,16 @@ def member_dynamic_stiffness(E, rho, A, inertia, L, omega) -> np.ndarray:
                                                          [-1.0, math.cos(k * L)]])
     D[np.ix_([0, 3], [0, 3])] = axial
     EI = E * inertia
-    beta = (rho * A * omega**2 / EI) ** 0.25
+    beta, alpha = _wavenumbers(E, rho, A, inertia, omega, tension)
 
     def derivs(x):
-        """w, w', w'', w''' of the four basis functions at x (rows)."""
-        c, s, ch, sh = math.cos(beta * x), math.sin(beta * x), math.cosh(beta * x), \
-            math.sinh(beta * x)
-        b = beta
-        return np.array([[c, s, ch, sh],
-                         [-b * s, b * c, b * sh, b * ch],
-                         [-b * b * c, -b * b * s, b * b * ch, b * b * sh],
-                         [b**3 * s, -b**3 * c, b**3 * sh, b**3 * ch]])
+        """w, w′, w″, w‴ of the four basis functions at x (rows)."""
+        return np.array([_basis(beta, x, order, alpha) for order in range(4)])
 
     d0, d1 = derivs(0.0), derivs(L)
     B = np.array([d0[0], d0[1], d1[0], d1[1]])
-    F = np.array([EI * d0[3], -EI * d0[2], -EI * d1[3], EI * d1[2]])
+    F = np.array([EI * d0[3] - tension * d0[1], -EI * d0[2],
+                  -EI * d1[3] + tension * d1[1], EI * d1[2]])
     D[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = F @ np.linalg.inv(B)
     return D
 
@@ -77,7 +86,7 @@ class ExactFrame:
         fixed = {3 * self.ids.index(i) + d for i, t in supports.items() for d in SUPPORTS[t]}
         fixed -= {dof for dof, _ in self.ground}
         self.free = np.array([d for d in range(n) if d not in fixed])
-        E, _, _, inertia = members[0][2:]
+        E, _, _, inertia = members[0][2:6]
         L = max(self._length(m) for m in members)
         self.scale = E * inertia / L**3
 
@@ -88,7 +97,7 @@ class ExactFrame:
     def matrix(self, omega) -> np.ndarray:
         D = np.zeros((self.n, self.n))
         for k, m in enumerate(self.members):
-            a, b, E, rho, A, inertia = m
+            a, b, E, rho, A, inertia = m[:6]
             (x0, y0), (x1, y1) = self.nodes[a], self.nodes[b]
             L = math.hypot(x1 - x0, y1 - y0)
             c, s = (x1 - x0) / L, (y1 - y0) / L
@@ -96,7 +105,7 @@ class ExactFrame:
             T = np.zeros((6, 6))
             T[:3, :3], T[3:, 3:] = R, R
             dofs = self._member_dofs(k)
-            Dm = member_dynamic_stiffness(E, rho, A, inertia, L, omega)
+            Dm = member_dynamic_stiffness(E, rho, A, inertia, L, omega, _tension(m))
             D[np.ix_(dofs, dofs)] += T.T @ Dm @ T
         for i, j, k in self.springs:
             D[np.ix_([i, j], [i, j])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
@@ -160,7 +169,7 @@ class ExactFrame:
                 out.append(direction @ full[i:i + 2])
                 continue
             k = self.member_ids.index(s["member"])
-            a, b, E, rho, A, inertia = self.members[k]
+            a, b, E, rho, A, inertia = self.members[k][:6]
             L, c, sn = self._member_axes(k)
             R = np.array([[c, sn], [-sn, c]])
             dofs = self._member_dofs(k)
@@ -170,22 +179,70 @@ class ExactFrame:
             x = s["position"]
             ka = w * math.sqrt(rho / E)
             axial = (u1 * math.sin(ka * (L - x)) + u2 * math.sin(ka * x)) / math.sin(ka * L)
-            beta = (rho * A * w**2 / (E * inertia)) ** 0.25
-
-            B = np.array([_basis(beta, 0, 0), _basis(beta, 0, 1), _basis(beta, L, 0),
-                          _basis(beta, L, 1)])
+            beta, alpha = _wavenumbers(E, rho, A, inertia, w, _tension(self.members[k]))
+            B = np.array([_basis(beta, 0, 0, alpha), _basis(beta, 0, 1, alpha),
+                          _basis(beta, L, 0, alpha), _basis(beta, L, 1, alpha)])
             coef = np.linalg.solve(B, [v1, g[2], v2, g[5]])
-            transverse = _basis(beta, x, 0) @ coef
+            transverse = _basis(beta, x, 0, alpha) @ coef
             out.append(direction @ (R.T @ np.array([axial, transverse])))
         return np.array(out)
 
 
-def _basis(beta, t, order):
-    """cos βt, sin βt, cosh βt, sinh βt (order 0) or their derivatives (order 1)."""
-    f = [math.cos(beta * t), math.sin(beta * t), math.cosh(beta * t), math.sinh(beta * t)]
-    if order == 0:
-        return np.array(f)
-    return beta * np.array([-f[1], f[0], f[3], f[2]])
+def _basis(beta, t, order, alpha=None):
+    """cos βt, sin βt, cosh αt, sinh αt (α = β without an axial force) or their derivative
+    of ``order`` (0 to 3)."""
+    a = beta if alpha is None else alpha
+    c, s, ch, sh = math.cos(beta * t), math.sin(beta * t), math.cosh(a * t), math.sinh(a * t)
+    b = beta
+    return np.array([[c, s, ch, sh],
+                     [-b * s, b * c, a * sh, a * ch],
+                     [-b**2 * c, -b**2 * s, a**2 * ch, a**2 * sh],
+                     [b**3 * s, -b**3 * c, a**3 * sh, a**3 * ch]][order])
+
+
+def _tension(member) -> float:
+    """A member tuple's axial force (its seventh entry; 0 without one)."""
+    return float(member[6]) if len(member) > 6 else 0.0
+
+
+def member_static_stiffness(E, A, inertia, L) -> np.ndarray:
+    """(6, 6) exact static stiffness of a uniform Euler–Bernoulli member in its axes."""
+    EA, EI = E * A, E * inertia
+    K = np.zeros((6, 6))
+    K[np.ix_([0, 3], [0, 3])] = EA / L * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    K[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = EI / L**3 * np.array(
+        [[12, 6 * L, -12, 6 * L], [6 * L, 4 * L**2, -6 * L, 2 * L**2],
+         [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L**2, -6 * L, 4 * L**2]])
+    return K
+
+
+def self_stress(nodes, members, supports, shortened, strain) -> list[float]:
+    """The axial force [N] (tension > 0) of every member of a frame (``nodes``, ``members``,
+    ``supports`` as :class:`ExactFrame` takes them; rigid joints) when member ``shortened``
+    (its index) is made shorter by ``strain`` × its length before it is fitted in, as a
+    turnbuckle does: the linear static solution by the exact member stiffness."""
+    ids = list(nodes)
+    n = 3 * len(ids)
+    K, f = np.zeros((n, n)), np.zeros(n)
+    axes = []
+    for k, (a, b, E, _, A, inertia) in enumerate(m[:6] for m in members):
+        (x0, y0), (x1, y1) = nodes[a], nodes[b]
+        L = math.hypot(x1 - x0, y1 - y0)
+        c, s = (x1 - x0) / L, (y1 - y0) / L
+        R = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+        T = np.zeros((6, 6))
+        T[:3, :3], T[3:, 3:] = R, R
+        dofs = [3 * ids.index(a) + i for i in range(3)] + [3 * ids.index(b) + i for i in range(3)]
+        K[np.ix_(dofs, dofs)] += T.T @ member_static_stiffness(E, A, inertia, L) @ T
+        locked = E * A * strain if k == shortened else 0.0   # its pull on its end nodes
+        f[dofs] += locked * np.array([c, s, 0.0, -c, -s, 0.0])
+        axes.append((dofs, c, s, E * A / L, locked))
+    fixed = {3 * ids.index(i) + d for i, t in supports.items() for d in SUPPORTS[t]}
+    free = np.array([d for d in range(n) if d not in fixed])
+    u = np.zeros(n)
+    u[free] = np.linalg.solve(K[np.ix_(free, free)], f[free])
+    return [float(stiffness * (c * (u[dofs[3]] - u[dofs[0]]) + s * (u[dofs[4]] - u[dofs[1]]))
+                  + locked) for dofs, c, s, stiffness, locked in axes]
 
 
 def zone_frame(model, member_id, a, b, stiffness_ratio, area_ratio):

@@ -20,10 +20,13 @@ from gfe_opt.problems import portal_frame, problem_file, three_storey_frame
 from .frame_reference import ExactFrame, member_dynamic_stiffness, zone_frame
 
 
-def exact_of(model, joint_springs=(), ground_springs=()):
-    return ExactFrame(model.nodes, [(m.start, m.end, m.E, m.rho, m.area, m.inertia)
-                                    for m in model.members], dict(model.supports),
-                      joint_springs, [m.id for m in model.members], ground_springs)
+def exact_of(model, joint_springs=(), ground_springs=(), tensions=None):
+    """The exact frame of ``model``'s geometry and sections (``tensions``: {member: N})."""
+    tensions = tensions or {}
+    return ExactFrame(model.nodes, [(m.start, m.end, m.E, m.rho, m.area, m.inertia,
+                                     tensions.get(m.id, 0.0)) for m in model.members],
+                      dict(model.supports), joint_springs, [m.id for m in model.members],
+                      ground_springs)
 
 
 def refined(model, n):
@@ -159,6 +162,56 @@ def test_a_section_loss_adds_exactly_its_mass():
                                                 rel=1e-12)
 
 
+def test_axial_loads_on_members_converge_to_the_exact_frequencies():
+    """A column under 30 % of its Euler load π²EI/h² in compression and the beam pulled by
+    15 % of its own (tests/frame_reference.py: the exact members with EI w⁗ − T w″): the
+    geometric stiffness converges as h⁴ like the bending elements, to 1e-6 on 64 elements a
+    member; compression lowers the sway frequency, tension of the beam alone raises it."""
+    base = portal_frame()
+    euler = {m.id: math.pi**2 * m.E * m.inertia / base.member_length(m) ** 2
+             for m in base.members}
+    tensions = {"left-column": -0.3 * euler["left-column"], "beam": 0.15 * euler["beam"]}
+    loads = [Effect("axial_load", {"member": k, "tension": v}) for k, v in tensions.items()]
+    exact_plain = exact_of(base)
+    exact = exact_of(base, tensions=tensions)
+    err = {}
+    for n in (8, 16, 64):
+        f = frame_modes(refined(base, n).with_effects(loads), 6).frequencies_hz
+        err[n] = f / np.array([exact.frequency_near(x, 1e-3) for x in f]) - 1
+    assert np.max(np.abs(err[64])) < 1e-6
+    bending = np.log2(np.abs(err[8] / err[16]))[[1, 3, 5]]
+    assert np.all((3.7 < bending) & (bending < 4.3)), bending
+    sway = exact_plain.frequency_near(frame_modes(refined(base, 64), 1).frequencies_hz[0])
+    pushed, pulled = (frame_modes(refined(base, 64).with_effects([e]), 1).frequencies_hz[0]
+                      for e in loads)
+    assert pushed < sway * (1 - 1e-3) and pulled > sway * (1 + 1e-5)
+
+
+def test_an_axial_load_on_a_one_member_frame_is_blevins_simply_supported_beam():
+    """A horizontal member pinned at one end and on a roller (free along x) at the other,
+    pulled by T = 2 P_E and pushed by T = −0.5 P_E: its bending frequencies are
+    ω_n/ω_n0 = √(1 + T/(n² P_E)) (Blevins, table 8-1; REFERENCES.md) to 1e-6."""
+    from gfe_opt.frame import frame_from_dict
+
+    data = {"name": "tie", "kind": "frame", "material": {"E": 210e9, "rho": 7850.0},
+            "section": {"shape": "rectangle", "b": 0.05, "h": 0.01},
+            "nodes": [{"id": "A", "x": 0.0, "y": 0.0}, {"id": "B", "x": 0.8, "y": 0.0}],
+            "members": [{"id": "tie", "from": "A", "to": "B", "elements": 96}],
+            "supports": [{"node": "A", "type": "pinned"}, {"node": "B", "type": "roller-x"}]}
+    tie = frame_from_dict(data)
+    m = tie.member("tie")
+    EI, rhoA, L = m.E * m.inertia, m.rho * m.area, 0.8
+    euler = math.pi**2 * EI / L**2
+    for ratio in (2.0, -0.5):
+        f = frame_modes(tie.with_effects([Effect("axial_load", {"member": "tie",
+                                                                "tension": ratio * euler})]),
+                        6).frequencies_hz
+        for n in (1, 2, 3, 4):
+            plain = (n * math.pi / L) ** 2 * math.sqrt(EI / rhoA) / (2 * math.pi)
+            closed = plain * math.sqrt(1 + ratio / n**2)
+            assert np.min(np.abs(f / closed - 1)) < 1e-6, (ratio, n, f, closed)
+
+
 def test_kept_members_and_patterns_assemble_what_a_plain_sum_does():
     """frame_matrices keeps each member's elements and each mesh's sparse pattern between
     models: K and M equal, to rounding, the sum built here entry by entry from the element
@@ -288,6 +341,12 @@ def _zone(**changes):
                                       "node": "B", "stiffness": 10.0}] * 2}), "effects[1]"),
     (lambda d: d.update({"effects": [{"effect": "axial_stiffness", "member": "beam",
                                       "ratio": 0.5}] * 2}), "effects[1]"),
+    (lambda d: d.update({"effects": [{"effect": "axial_load", "member": "beam",
+                                      "tension": "high"}]}), "effects[0].tension"),
+    (lambda d: d.update({"effects": [{"effect": "axial_load", "member": "brace",
+                                      "tension": 1.0}]}), "effects[0].member"),
+    (lambda d: d.update({"effects": [{"effect": "axial_load", "member": "beam",
+                                      "tension": 1.0}] * 2}), "effects[1]"),
     (lambda d: d.update({"effects": [{"effect": "material", "E": 210.0}]}), "effects[0].E"),
     (lambda d: d.update({"effects": [{"effect": "material", "E": 2e11, "member": "beam"}]}),
      "effects[0].member"),
@@ -658,19 +717,23 @@ def test_the_fit_finds_semi_rigid_joints_from_an_exact_test():
     assert result.freq_error_rms_pct == pytest.approx(out.after.freq_error_rms_pct, rel=1e-6)
 
 
-def test_joint_spring_jacobian_is_the_central_difference_of_the_residual():
-    """The analytic Jacobian (eigen-derivatives, ∂K of the joint spring from its matrices)
-    on a frame, against central differences of the residual, to 1e-6."""
+@pytest.mark.parametrize("effect", [
+    Effect("joint_spring", {"node": "B", "member": "beam", "stiffness": 3000.0}),
+    Effect("axial_load", {"member": "left-column", "tension": -20000.0})])
+def test_frame_jacobian_is_the_central_difference_of_the_residual(effect):
+    """The analytic Jacobian (eigen-derivatives, ∂K of the effect from its matrices) on a
+    frame, against central differences of the residual, to 1e-6."""
     from gfe_opt.diagnosis import noise_of
+    from gfe_opt.effects import effect_type
     from gfe_opt.fitting import fit_problem
     from gfe_opt.frame_data import load_frame_measured
 
     model = portal_frame(8)
     measured = load_frame_measured(problem_file("portal-frame-semirigid.json"), model)
-    effects = [Effect("joint_spring", {"node": "B", "member": "beam", "stiffness": 3000.0})]
-    problem = fit_problem(model, measured, effects, noise=noise_of(0.0005, 0.003))
-    beam = model.member("beam")
-    z = np.array([np.log10(3000.0 / (4 * beam.E * beam.inertia / model.member_length(beam)))])
+    problem = fit_problem(model, measured, [effect], noise=noise_of(0.0005, 0.003))
+    kind = effect_type(effect.name)
+    fixed = {k: effect.parameters[k] for k in kind.fixed_keys(model)}
+    z = kind.to_variables(model, kind.variables(model, fixed), effect.parameters)
     r = problem.residual(z)
     J = problem.residual.jacobian(z, r, problem.lower, problem.upper)
     h = 1e-4

@@ -280,6 +280,11 @@ class EffectType:
         """The frame's place parameters, then the others (what :meth:`describe` prints)."""
         return (*self.frame_parameters, *self.parameters)
 
+    def is_local(self, model) -> bool:
+        """Whether the effect may appear more than once in ``model`` (:attr:`local`; an
+        effect global on a beam may be one a member on a frame)."""
+        return self.local
+
     def parameter(self, key: str) -> Parameter:
         return next(p for p in self.all_parameters if p.name == key)
 
