@@ -24,7 +24,13 @@ drawn from the seed:
   in bending (a thinned or a doubled section: its depth changed, so its area and mass by
   the cube root of that): the exact solution of the member split at the zone's edges,
   the middle part's I and A scaled (the cases of the other classes are drawn from seeds
-  of their own, unchanged by the additions of ``material`` and ``zone``).
+  of their own, unchanged by the additions of ``material`` and ``zone``);
+* ``tension``: the portal with a slender diagonal brace (``tests/test_frame_diagnosis.py``'s
+  braced portal; the model has the brace) made 10⁻⁴ to 10⁻³ of its length shorter before it
+  was pinned in (a turnbuckle): every member's axial force from the exact static solution
+  (the brace pulls 20 to 200 N, 2.5 to 25 % of its Euler load; the portal's members push
+  back), each carried by the exact frame's member (EI w⁗ − T w″); the answer an
+  ``axial_load`` of the brace, its size the brace's force.
 
 Noise 1 to 2.5 times 0.3 % shape / 0.05 % frequency, stated (its true level) in half the
 cases.  The loop is the beam campaign's (``bench_diagnosis.follow``): ``diagnose``; while
@@ -75,10 +81,10 @@ from gfe_opt.diagnosis import diagnose  # noqa: E402
 from gfe_opt.frame import frame_modes  # noqa: E402
 from gfe_opt.model import Effect  # noqa: E402
 from gfe_opt.problems import portal_frame  # noqa: E402
-from tests.frame_reference import ExactFrame, zone_frame  # noqa: E402
-from tests.test_frame_diagnosis import NOISE, _exact, _guess, _measured, _sensors  # noqa: E402
+from tests.frame_reference import ExactFrame, self_stress, zone_frame  # noqa: E402
+from tests.test_frame_diagnosis import NOISE, _braced_portal, _exact, _guess, _measured, _sensors  # noqa: E402
 
-CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material", "zone")
+CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material", "zone", "tension")
 POSITION_TOLERANCE = 0.02
 DETECTABLE = 2.0     # first chi2/n at the stated noise below which a change is noise
 
@@ -163,6 +169,18 @@ def make_case(seed: int, group: str) -> dict:
         answers = [{"name": "material", "size": model.E * (scale - 1.0), "base": model.E}]
     elif group == "zone":
         exact, where, answers, bracket = _zone(model, rng)
+    elif group == "tension":
+        model = _braced_portal()
+        members = [(m.start, m.end, m.E, m.rho, m.area, m.inertia) for m in model.members]
+        ids = [m.id for m in model.members]
+        forces = self_stress(model.nodes, members, dict(model.supports), ids.index("brace"),
+                             _log_uniform(rng, 1e-4, 1e-3))
+        exact = ExactFrame(model.nodes, [(*m, t) for m, t in zip(members, forces)],
+                           dict(model.supports), (), ids)
+        bracket = [Effect("axial_load", {"member": i, "tension": t})
+                   for i, t in zip(ids, forces)]
+        answers = [{"name": "axial_load", "member": "brace",
+                    "size": forces[ids.index("brace")]}]
     else:
         raise ValueError(group)
     factor = float(rng.uniform(1.0, 2.5))
@@ -208,6 +226,8 @@ def _matches(model, effect: Effect, answer: dict) -> bool:
     if answer["name"] in ("crack", "section_loss"):
         return p.get("member") == answer["member"] and abs(
             p["position"] - answer["position"]) <= POSITION_TOLERANCE * answer["length"]
+    if answer["name"] == "axial_load":
+        return p.get("member") == answer["member"]
     if answer["name"] == "point_mass":
         member = model.member(p["member"])
         L = model.member_length(member)
@@ -222,7 +242,7 @@ def _size(model, effect: Effect):
     if effect.name == "section_loss":   # the added bending compliance (rad / (N m))
         m = model.member(p["member"])
         return p["length"] * (1 / p["stiffness_ratio"] - 1) / (m.E * m.inertia)
-    return p.get("stiffness", p.get("mass", p.get("E")))
+    return p.get("stiffness", p.get("mass", p.get("E", p.get("tension"))))
 
 
 def run_case(case: dict) -> dict:

@@ -30,6 +30,9 @@ SUPPORTS = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y"
 def _wavenumbers(E, rho, A, inertia, omega, tension=0.0):
     """(β, α) of a member's transverse motion at ω: w = cos βx, sin βx, cosh αx, sinh αx."""
     EI = E * inertia
+    if tension == 0.0:   # β = α = (ρAω²/EI)^¼, in the arithmetic the records were made with
+        beta = (rho * A * omega**2 / EI) ** 0.25
+        return beta, beta
     root = math.sqrt(tension**2 + 4.0 * EI * rho * A * omega**2)
     return math.sqrt((root - tension) / (2 * EI)), math.sqrt((root + tension) / (2 * EI))
 
