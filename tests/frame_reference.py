@@ -199,7 +199,7 @@ def _basis(beta, t, order, alpha=None):
     b = beta
     return np.array([[c, s, ch, sh],
                      [-b * s, b * c, a * sh, a * ch],
-                     [-b**2 * c, -b**2 * s, a**2 * ch, a**2 * sh],
+                     [-b * b * c, -b * b * s, a * a * ch, a * a * sh],
                      [b**3 * s, -b**3 * c, a**3 * sh, a**3 * ch]][order])
 
 
