@@ -107,7 +107,7 @@ def test_readme_commands_name_files_that_exist():
 def test_the_frame_campaign_builds_every_class_from_the_exact_frame():
     """scripts/bench_frame_diagnosis.py's generator (its crack bracket once failed, found
     only by a run): every class builds 6 modes at the sensors from the exact solution, the
-    answers name a place on the portal, and a hidden change moves the frequencies off the
+    answers name a place on the frame, and a hidden change moves the frequencies off the
     model as it stands while 'none' does not beyond the noise."""
     sys.path.insert(0, str(SCRIPTS))
     try:
@@ -121,14 +121,18 @@ def test_the_frame_campaign_builds_every_class_from_the_exact_frame():
     for i, group in enumerate(campaign.CLASSES):
         case = campaign.make_case(4000 + i, group)
         measured, model = case["measured"], case["model"]
-        assert measured.n_modes == 6 and measured.n_sensors == 14, group
+        # x and y at two points a member, and the joints B (x) and C (y)
+        assert measured.n_modes == 6 and measured.n_sensors == 2 + 4 * len(model.members), group
         assert (len(case["answers"]) == 0) == (group == "none")
         assert (len(case["answers"]) == 2) == (group == "joints")
-        for answer in case["answers"]:   # a place on the portal; a material has none
+        for answer in case["answers"]:   # a place on the frame; a material has none
             assert answer.get("node") in model.nodes or answer.get("member") in {
                 m.id for m in model.members} or (answer["name"], group) == (
                 "material", "material"), answer
         f0 = frame_modes(model, 6).frequencies_hz
         shift = np.max(np.abs(measured.frequencies_hz / f0 - 1))
-        noise = 4 * campaign.NOISE["freq_noise"] * case["noise_factor"]
-        assert (shift > noise) == (group != "none"), (group, shift, noise)
+        noise = campaign.NOISE["freq_noise"] * case["noise_factor"]
+        if group == "none":
+            assert shift < 4 * noise, (group, shift, noise)
+        else:   # a brace's weakest pull (20 N) moves its modes by a few noise levels only
+            assert shift > (2 if group == "tension" else 4) * noise, (group, shift, noise)
