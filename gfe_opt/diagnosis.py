@@ -1563,7 +1563,7 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     for e in effects:
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
                                      partial=True)
-    if model.kind == "frame":   # one joint spring, one axial load a member end, as in a file
+    if model.kind == "frame":   # one joint spring a member end, one axial load a member
         from .frame import check_repeats as check_frame_repeats
 
         check_frame_repeats([*model.effects, *effects], "--add")

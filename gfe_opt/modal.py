@@ -124,7 +124,8 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     lam = np.where(np.abs(lam) < roundoff, 0.0, lam)
     if np.any(lam < 0):
         raise GfeSolverError(f"eigen solve returned negative eigenvalues {lam[lam < 0]}: "
-                             "stiffness is not positive semidefinite")
+                             "the stiffness is not positive semidefinite (a compression above "
+                             "the buckling load, or a negative spring?)")
     shapes = np.zeros((n, n_modes))
     shapes[free] = d[:, None] * vec
     gen_mass = np.einsum("ij,ij->j", shapes, M @ shapes)
