@@ -462,7 +462,7 @@ def test_a_brace_pulled_tight_is_fitted_as_the_axial_load_of_that_brace():
     assert out.before.chi2_per_residual > 20 and out.after.chi2_per_residual < 1.5
 
 
-@pytest.mark.slow   # 90 s; the update of the test above is its fit
+@pytest.mark.slow   # about 35 s; the update of the test above is its fit
 def test_a_brace_pulled_tight_is_diagnosed_as_its_axial_load_and_then_the_portal_agrees():
     model, measured, force = _tensioned_brace(5e-4, 32)
     d = _diagnose(model, measured, **NOISE)
