@@ -39,10 +39,13 @@ class AxialLoad(EffectType):
         if model.kind == "frame":
             member = model.member(fixed["member"])
             euler = np.pi**2 * member.E * member.inertia / model.member_length(member) ** 2
-            return [Variable("tension", -0.95, 50.0, (-0.5, 0.0, 0.5, 2.0, 8.0),
-                             scale=lambda m: euler)]
-        return [Variable("tension", -0.95, 50.0, (-0.5, 0.0, 0.5, 2.0, 8.0),
-                         scale=lambda m: np.pi**2 * nominal_rigidity(m) / m.length**2)]
+
+            def scale(m):
+                return euler
+        else:
+            def scale(m):
+                return np.pi**2 * nominal_rigidity(m) / m.length**2
+        return [Variable("tension", -0.95, 50.0, (-0.5, 0.0, 0.5, 2.0, 8.0), scale=scale)]
 
     def starts(self, model, hint):
         """On a frame every member; a beam's force is one."""
