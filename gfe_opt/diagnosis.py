@@ -539,19 +539,23 @@ def _run_jobs(jobs, progress, labels):
 
 
 def warm_solver() -> None:
-    """Load IPOPT (CasADi's plugin, its linear solver) and LAPACK's eigen solver once in this
+    """Load LAPACK's eigen solver (and IPOPT, CasADi's plugin, when fits use it) once in this
     process, by a trivial solve of each: forked workers inherit them loaded (measured: the
     first fit in a fresh worker took 0.1 s against 0.02 s for the same fit next)."""
     global _WARM
     if _WARM:
         return
-    import casadi as ca
     import scipy.linalg as sla
 
-    x = ca.MX.sym("x", 2)
-    solver = ca.nlpsol("warm", "ipopt", {"x": x, "f": ca.sumsqr(x - 1)},
-                       {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes"})
-    solver(x0=[0, 0], lbx=[-2, -2], ubx=[2, 2])
+    from . import fitting
+
+    if fitting.FIT_SOLVER == "ipopt":
+        import casadi as ca
+
+        x = ca.MX.sym("x", 2)
+        solver = ca.nlpsol("warm", "ipopt", {"x": x, "f": ca.sumsqr(x - 1)},
+                           {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes"})
+        solver(x0=[0, 0], lbx=[-2, -2], ubx=[2, 2])
     sla.eigh(np.diag([2.0, 1.0, 3.0]), np.eye(3), subset_by_index=[0, 1])
     _WARM = True
 
@@ -755,7 +759,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         if f.failed:
             f.notes.append(f"at best χ²/n {f.misfit.chi2_per_residual:.4g}, no better than "
                            "without it" if no_gain else
-                           f"the fit did not converge (last IPOPT status {f.status})")
+                           f"the fit did not converge (solver status {f.status})")
     sel = _Selection(ref_misfit.chi2, ref_params, len(fits) + len(fallback_names),
                      measured.n_modes)
     sel.floor = _floor([*fits, reference])
@@ -1610,7 +1614,7 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
         fit = fit_effects(model, measured, starts, noise=noise, C=C,
                           name=" + ".join(e.name for e in effects))
     if not fit.success:
-        raise GfeSolverError(f"the fit of the effects did not converge (last IPOPT status "
+        raise GfeSolverError(f"the fit of the effects did not converge (solver status "
                              f"{fit.status})")
     return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit,
                          added=list(range(len(model.effects), len(fit.effects))),

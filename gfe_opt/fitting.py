@@ -1,4 +1,4 @@
-r"""Fitting the physical parameters of effects to measured modes (IPOPT, Gauss–Newton).
+r"""Fitting the physical parameters of effects to measured modes (damped Gauss–Newton).
 
 Misfit
 ------
@@ -19,12 +19,15 @@ Every instance of an effect in the model is a *slot*: its fitted parameters are 
 variables (:class:`~gfe_opt.effects.Variable`, with bounds), its chosen ones (a spring's
 side, a profile's knots) are fixed.  Instances already in the model start where they are;
 added ones start from given values or from the best point of a coarse grid.  χ² is
-minimised by IPOPT through CasADi: the objective ½‖r‖², its gradient Jᵀr and the
-Gauss–Newton Hessian JᵀJ come from one forward-difference Jacobian J per point (small
-callbacks: IPOPT sees n × n matrices, however many residuals there are).  IPOPT finds the
-valley; :func:`_finish` then converges to the optimum by a scale-free rule (the Newton
-decrement below 1e-9 noise floors), so that machines whose arithmetic differs in the last
-bits end at the same point; a fit whose finish does not settle has failed.
+minimised by damped Newton steps (:func:`_finish`: the analytic Jacobian J, the Hessian
+JᵀJ plus the Dennis–Gay–Welsch secant estimate of the second-order term, a
+Levenberg–Marquardt damping, bounds held by projection) until a scale-free rule holds (the
+Newton decrement below 1e-9 noise floors), so that machines whose arithmetic differs in the
+last bits end at the same point; a fit that does not settle has failed.  The old path,
+IPOPT through CasADi to the valley and then the same steps (``GFE_OPT_FIT_SOLVER=ipopt``:
+the objective ½‖r‖², its gradient Jᵀr and the Gauss–Newton Hessian JᵀJ as small callbacks),
+stays for comparison (``scripts/bench.py --parts fits,frames``): it took twice the
+evaluations to the same optima, its interior point crawling to parameters on a bound.
 
 Uncertainty
 -----------
@@ -41,7 +44,6 @@ import os
 from collections import Counter
 from dataclasses import dataclass, field
 
-import casadi as ca
 import numpy as np
 from scipy.linalg import block_diag
 from scipy.special import chdtri
@@ -442,6 +444,14 @@ JACOBIAN = os.environ.get("GFE_OPT_JACOBIAN", "analytic")
 if JACOBIAN not in ("analytic", "difference"):
     raise GfeInputError("GFE_OPT_JACOBIAN", None, f"must be 'analytic' or 'difference', got "
                         f"{JACOBIAN!r}")
+#: what minimises an effect fit from its start: "newton" (the finish's damped Newton steps,
+#: :func:`_finish`, from the start on) or "ipopt" (IPOPT through CasADi to the valley, then
+#: the finish: the old path, kept for scripts/bench.py --parts fits, which sets it for every
+#: process through the environment variable GFE_OPT_FIT_SOLVER)
+FIT_SOLVER = os.environ.get("GFE_OPT_FIT_SOLVER", "newton")
+if FIT_SOLVER not in ("newton", "ipopt"):
+    raise GfeInputError("GFE_OPT_FIT_SOLVER", None, f"must be 'newton' or 'ipopt', got "
+                        f"{FIT_SOLVER!r}")
 #: errors of a trial model that make its residual the failed one
 _TRIAL_ERRORS = (GfeInputError, GfeSolverError, ValueError, FloatingPointError,
                  np.linalg.LinAlgError)
@@ -528,6 +538,19 @@ class FitProblem:
         could not certify its stopping rule."""
         return np.clip(self._per_slot(z, lambda slot, zs: slot.effect.untie(
             self.base, slot.variables, zs)), self.lower, self.upper)
+
+    def snapped(self, z) -> np.ndarray | None:
+        """``z`` with each effect's edge that stopped short of an end moved onto it
+        (:meth:`EffectType.snap`), or None when no effect has one."""
+        moved = False
+
+        def one(slot, zs):
+            nonlocal moved
+            out = slot.effect.snap(self.base, slot.variables, zs)
+            moved = moved or out is not None
+            return zs if out is None else out
+        z = np.clip(self._per_slot(z, one), self.lower, self.upper)
+        return z if moved else None
 
     def _per_slot(self, z, fn) -> np.ndarray:
         z = np.array(z, dtype=float)
@@ -640,6 +663,13 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
         converged = [e for e in ends if e[3]] or ends
         z, value, status, success = converged[lowest([e[1] for e in converged])]
         floor = max(1.0, value / max(n_res - z.size, 1))
+        snapped = problem.snapped(z) if success else None
+        if snapped is not None:
+            # an edge that stopped short of an end: the fit again with it on the end, kept
+            # when as good to the finish's own margin (one parameter fewer; the same valley)
+            other = _minimise(residual, chi2, snapped, lower, upper, max_iter)
+            if other[3] and other[1] <= value + FINISH_SETTLED * floor:
+                z, value, status, success = problem.canonical(other[0]), *other[1:]
         for other in converged:
             # only converged ends are compared, with a margin far above their precision
             if (other[1] - value < ALIKE_CHI2 * floor and np.max(np.abs(other[0] - z)) > 0.05
@@ -698,9 +728,6 @@ def ranked(values) -> list[int]:
 PROFILE_GRID_LIMIT = 200
 PROFILE_STEPS = 3
 PROFILE_STARTS = 3
-#: IPOPT runs restarted from where the last ended while each lowers χ² by more than this
-RESTART_GAIN = 0.9
-MAX_RESTARTS = 4
 
 
 def _profile_starts(residual, chi2, z0, grids, slots, lower, upper, nulls=None) -> list:
@@ -753,50 +780,33 @@ def _profile_starts(residual, chi2, z0, grids, slots, lower, upper, nulls=None) 
 
 
 def _minimise(residual, chi2, z_start, lower, upper, max_iter):
-    """IPOPT on ½‖r‖²/scale from ``z_start`` (module docstring), then :func:`_finish`.
+    """Minimise χ² from ``z_start`` (module docstring).  With :data:`FIT_SOLVER`
+    ``"newton"`` (the default) :func:`_finish` runs from the start (:data:`NEWTON_STEPS`
+    steps) and the status is its outcome ("converged", "settled", "not_converged"); with
+    ``"ipopt"`` IPOPT finds the valley first (:func:`gfe_opt.fit_ipopt.ipopt_valley`; its
+    "acceptable" stop is off: it stopped on finite-difference noise at points that differed
+    with the BLAS kernel), the status is its last run's, and the finish converges from
+    there.  Returns (z, χ², status, whether the finish met its rule)."""
+    if FIT_SOLVER == "newton":
+        z, value, decrement = _finish(residual, z_start, chi2(z_start), lower, upper,
+                                      steps=NEWTON_STEPS)
+        outcome = _outcome(decrement)
+        SOLVER_TALLY[outcome] += 1
+        return z, value, outcome, outcome != "not_converged"
+    from .fit_ipopt import ipopt_valley
 
-    IPOPT finds the valley: it is restarted from where it ended while χ² keeps falling by
-    more than 10 % (the objective is scaled by χ² at the start, so a run that lowers χ² a
-    hundredfold meets its tolerances early: measured on a clamp spring with a tip mass
-    fitted from frequencies, χ² 3e6 -> 3e4 in the first run).  Its "acceptable" stop is
-    off: it stopped on finite-difference noise at points that differed with the BLAS
-    kernel.  The finish then converges to the optimum by a stopping rule that does not
-    depend on how the parameters are scaled.  Returns (z, χ², status, converged): the
-    status of the last IPOPT run, and whether the finish met its rule."""
-    z, value = z_start, chi2(z_start)
-    status = "Nothing_To_Fit"
-    n = z.size
-    for _ in range(MAX_RESTARTS):
-        scale = max(value, 1.0)  # objective starts at 1/2: relative tolerances
-        objective = _GaussNewton(residual, n, scale, lower, upper)
-        x = ca.MX.sym("z", n)
-        solver = ca.nlpsol("effects", "ipopt", {"x": x, "f": objective(x)},
-                           {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
-                            "ipopt.max_iter": max_iter, "ipopt.tol": 1e-3,
-                            # measured: the adaptive barrier halves the evaluations
-                            "ipopt.mu_strategy": "adaptive",
-                            # on a flat objective with finite-difference gradients the line
-                            # search backtracked 20-40 times a step: accept after 4
-                            "ipopt.accept_after_max_steps": 4,
-                            # no "acceptable" stop: the finish converges (see above)
-                            "ipopt.acceptable_iter": 0})
-        sol = solver(x0=z, lbx=lower, ubx=upper)
-        stats = solver.stats()
-        trial = np.array(sol["x"]).ravel()
-        trial_value = chi2(trial)
-        status = str(stats.get("return_status"))
-        if not trial_value < value:  # never return worse than the start (nor NaN)
-            break
-        gain = trial_value < RESTART_GAIN * value
-        z, value = trial, trial_value
-        if not gain:
-            break
+    z, value, status = ipopt_valley(residual, chi2, z_start, lower, upper, max_iter)
     SOLVER_TALLY[status] += 1
     z, value, decrement = _finish(residual, z, value, lower, upper)
-    outcome = ("converged" if decrement < FINISH_DECREMENT else
-               "settled" if decrement < FINISH_SETTLED else "not_converged")
+    outcome = _outcome(decrement)
     SOLVER_TALLY[outcome] += 1
     return z, value, status, outcome != "not_converged"
+
+
+def _outcome(decrement: float) -> str:
+    """The finish's outcome from its last decrement in noise floors."""
+    return ("converged" if decrement < FINISH_DECREMENT else
+            "settled" if decrement < FINISH_SETTLED else "not_converged")
 
 
 #: the finish stops when a full Newton (and Gauss–Newton) step would lower χ² by less than
@@ -810,6 +820,8 @@ FINISH_DECREMENT = 1e-9
 #: at 1e-5 from the end on one BLAS kernel and at the end on another).  Worse is a failed fit.
 FINISH_SETTLED = 1e-2
 FINISH_STEPS = 60
+#: the finish's steps when it runs from the start (:data:`FIT_SOLVER` "newton")
+NEWTON_STEPS = 100
 #: directions of the scaled Jacobian with singular values below this fraction of the largest
 #: are not determined by the data: their σ is 10⁴ times the best-determined one's (a zone at
 #: a clamp whose centre and length trade exactly shows 1e-6)
@@ -903,7 +915,11 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
         shift = max(0.0, -lowest_eig) + 1e-12 * sv[0] ** 2   # H + shift: positive definite
         accepted = False
         while lam <= 1e10:
-            w = -np.linalg.solve(H + (shift + lam * sv[0] ** 2) * np.eye(H.shape[0]), gk)
+            try:
+                w = -np.linalg.solve(H + (shift + lam * sv[0] ** 2) * np.eye(H.shape[0]), gk)
+            except np.linalg.LinAlgError:   # H + shift singular to rounding: damp more
+                lam = 1e-6 if lam == 0.0 else lam * 10.0
+                continue
             trial = z.copy()
             trial[free] = np.clip(z[free] + (V @ w) / d[free], lower[free], upper[free])
             r_trial = residual(trial)
@@ -912,6 +928,11 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
                 accepted = True
                 break
             lam = 1e-6 if lam == 0.0 else lam * 10.0
+        if not accepted and np.any(S):
+            # no step lowers χ² with the secant term built up along the way (from a start far
+            # off it may not fit here): Gauss–Newton again from this point
+            S, lam = np.zeros((n, n)), 0.0
+            continue
         if not accepted:  # no step lowers χ²: the optimum as far as rounding can tell
             return z, value, decrement / floor
         lam = 0.0 if lam <= 1e-6 else lam / 10.0
@@ -1258,131 +1279,3 @@ def _grid_start(chi2, grids, nulls=None):
             other[i] = points[lowest(rest)]
             informed = other
     return np.concatenate(current), (None if informed is None else np.concatenate(informed))
-
-
-# -------------------------------------------------------------------------------------------
-# CasADi callbacks: residual with a forward-difference Jacobian, Gauss–Newton Hessian
-# -------------------------------------------------------------------------------------------
-
-
-class _GaussNewton(ca.Callback):
-    """½‖r(z)‖² as a CasADi function of z with its gradient Jᵀr and the Gauss–Newton
-    Hessian JᵀJ, J the forward-difference Jacobian of r, computed once per point and shared:
-    IPOPT sees only n × n matrices, however many residuals there are."""
-
-    def __init__(self, residual, n: int, scale: float, lower, upper, step: float = 1e-6):
-        ca.Callback.__init__(self)
-        self.residual, self.n, self.step = residual, n, step
-        self.root = np.sqrt(scale)
-        self.lower, self.upper = lower, upper
-        self._point = None
-        self.construct("half_sum_of_squares", {})
-
-    def fun(self, z):
-        return self.residual(z) / self.root
-
-    def residual_and_jacobian(self, z):
-        key = z.tobytes()
-        if self._point is None or self._point[0] != key:
-            r0 = self.fun(z)
-            analytic = getattr(self.residual, "jacobian", None)
-            if analytic is not None:   # IPOPT may step a hair outside the bounds
-                inside = np.clip(z, self.lower, self.upper)
-                jac = analytic(inside, r0, self.lower, self.upper) / self.root \
-                    if np.array_equal(inside, z) else self._forward(z, r0)
-            else:
-                jac = self._forward(z, r0)
-            self._point = (key, r0, jac)
-        return self._point[1], self._point[2]
-
-    def _forward(self, z, r0):
-        jac = np.zeros((r0.size, self.n))
-        for k in range(self.n):
-            dz = z.copy()
-            h = self.step * max(1.0, abs(z[k]))
-            dz[k] += h
-            jac[:, k] = (self.fun(dz) - r0) / h
-        return jac
-
-    def get_n_in(self):
-        return 1
-
-    def get_n_out(self):
-        return 1
-
-    def get_sparsity_in(self, i):
-        return ca.Sparsity.dense(self.n, 1)
-
-    def get_sparsity_out(self, i):
-        return ca.Sparsity.dense(1, 1)
-
-    def eval(self, arg):
-        r = self.fun(np.array(arg[0]).ravel())
-        return [0.5 * float(r @ r)]
-
-    def has_jacobian(self):
-        return True
-
-    def get_jacobian(self, name, inames, onames, opts):
-        self._gradient = _Gradient(name, self)
-        return self._gradient
-
-
-class _Gradient(ca.Callback):
-    """d(½‖r‖²)/dz = (Jᵀr)ᵀ; its own Jacobian is the Gauss–Newton Hessian."""
-
-    def __init__(self, name, outer: _GaussNewton):
-        ca.Callback.__init__(self)
-        self.outer = outer
-        self.construct(name, {})
-
-    def get_n_in(self):
-        return 2
-
-    def get_n_out(self):
-        return 1
-
-    def get_sparsity_in(self, i):
-        return ca.Sparsity.dense(self.outer.n, 1) if i == 0 else ca.Sparsity.dense(1, 1)
-
-    def get_sparsity_out(self, i):
-        return ca.Sparsity.dense(1, self.outer.n)
-
-    def eval(self, arg):
-        r, jac = self.outer.residual_and_jacobian(np.array(arg[0]).ravel())
-        return [(jac.T @ r)[None, :]]
-
-    def has_jacobian(self):
-        return True
-
-    def get_jacobian(self, name, inames, onames, opts):
-        self._hessian = _Hessian(name, self.outer)
-        return self._hessian
-
-
-class _Hessian(ca.Callback):
-    """JᵀJ (the second derivative of r neglected) and a zero derivative with respect to
-    the objective value."""
-
-    def __init__(self, name, outer: _GaussNewton):
-        ca.Callback.__init__(self)
-        self.outer = outer
-        self.construct(name, {})
-
-    def get_n_in(self):
-        return 3
-
-    def get_n_out(self):
-        return 2
-
-    def get_sparsity_in(self, i):
-        n = self.outer.n
-        return [ca.Sparsity.dense(n, 1), ca.Sparsity.dense(1, 1), ca.Sparsity.dense(1, n)][i]
-
-    def get_sparsity_out(self, i):
-        return ca.Sparsity.dense(self.outer.n, self.outer.n) if i == 0 else \
-            ca.Sparsity.dense(self.outer.n, 1)
-
-    def eval(self, arg):
-        _, jac = self.outer.residual_and_jacobian(np.array(arg[0]).ravel())
-        return [jac.T @ jac, np.zeros((self.outer.n, 1))]

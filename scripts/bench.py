@@ -27,26 +27,27 @@ the regularisation holds it at its initial value).
    with 45 sensors, and `update --add crack` with a sensor at every node on 1000 and 2000
    elements, each in a fresh process (wall time, peak resident memory).
 
-7. Fits (issue 22), ``--parts fits``: the issue's table measured twice side by side, each
-   run in fresh processes with the fits' Jacobian from finite differences of the modal solves
-   (``GFE_OPT_JACOBIAN=difference``, the old path) and analytic (eigen-derivatives, the
-   default): ``diagnose`` on 46 elements in process (best of 3, first and after adding the
-   crack), from the shell (``gfe-opt diagnose --json``, wall, best of 3, a 46-element beam
-   with a point mass), on 2000 elements; ``update --add crack`` on 46 elements (best of 3);
-   one set of a campaign (``batch --add material --add crack``, 2 workers, wall per set);
-   ``gfe-opt --version`` (best of 3); peak resident memory of each run.  Every fit of both
-   (every candidate of every diagnosis, the updates, the demo's and the shipped real data's
-   diagnoses, every batch row) is compared: largest relative difference of the parameters
-   and of χ² (targets 1e-6 and 1e-9).
+7. Fits (issue 22), ``--parts fits``: the issue's table measured three times side by side,
+   each run in fresh processes: the fits' Jacobian from finite differences of the modal
+   solves with IPOPT (``GFE_OPT_JACOBIAN=difference GFE_OPT_FIT_SOLVER=ipopt``, the first
+   path), analytic (eigen-derivatives) with IPOPT (``GFE_OPT_FIT_SOLVER=ipopt``, the second)
+   and analytic with the damped Newton steps alone (the default): ``diagnose`` on 46
+   elements in process (best of 3, first and after adding the crack), from the shell
+   (``gfe-opt diagnose --json``, wall, best of 3, a 46-element beam with a point mass), on
+   2000 elements; ``update --add crack`` on 46 elements (best of 3); one set of a campaign
+   (``batch --add material --add crack``, 2 workers, wall per set); ``gfe-opt --version``
+   (best of 3); peak resident memory of each run.  Every fit (every candidate of every
+   diagnosis, the updates, the demo's and the shipped real data's diagnoses, every batch
+   row) is compared with the first path's: largest relative difference of the parameters,
+   in σ, and of χ².
 
 8. Frames (issue 24), ``--parts frames``: ``diagnose`` (noise stated) on the shipped
    semi-rigid portal (60 elements) and on the three-storey frame (120 elements, 6 modes,
    36 sensors: x and y at two points a member) with a 0.3 kg floor mass, its data from the
    package's frame on a 3x finer mesh with 0.3 % / 0.05 % noise; each in a fresh process
-   with the frame's old solves (dense eigen-solve and dense bordered derivatives, the
-   observation matrix rebuilt every evaluation) and the new ones (sparse above
-   ``frame.DENSE_SOLVE_DOFS``, Nelson's sparse derivatives, the observation kept a mesh):
-   wall time, verdicts and the largest relative difference of every fitted parameter.
+   with the fits by IPOPT (``GFE_OPT_FIT_SOLVER=ipopt``) and by the damped Newton steps
+   alone (the default): wall time, verdicts and the largest relative difference of every
+   fitted parameter.
 
 ``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale, fits, frames.
 """
@@ -122,9 +123,9 @@ def main():
     parser.add_argument("--max-elements", type=int, default=10000)
     parser.add_argument("--parts",
                         default="update,ratio,solvers,accuracy,diagnose,scale,fits,frames")
-    parser.add_argument("--fits-child", nargs=2, metavar=("JACOBIAN", "DIR"),
+    parser.add_argument("--fits-child", nargs=2, metavar=("SIDE", "DIR"),
                         help=argparse.SUPPRESS)
-    parser.add_argument("--frames-child", choices=("old", "new"), help=argparse.SUPPRESS)
+    parser.add_argument("--frames-child", choices=("ipopt", "newton"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.fits_child:
         print(json.dumps(_fits_child(Path(args.fits_child[1]))))
@@ -329,7 +330,8 @@ def _best_of(fn, repeats=REPEATS):
 
 
 def _fits_child(work: Path) -> dict:
-    """One side of part 7 (the Jacobian chosen by GFE_OPT_JACOBIAN), in this process."""
+    """One side of part 7 (the Jacobian and the solver chosen by GFE_OPT_JACOBIAN and
+    GFE_OPT_FIT_SOLVER), in this process."""
     from gfe_opt import fitting
     from gfe_opt.batch import read_table, run_batch
     from gfe_opt.diagnosis import diagnose, update
@@ -338,7 +340,7 @@ def _fits_child(work: Path) -> dict:
     from gfe_opt.problems import problem_file
     from gfe_opt.synthetic import interior_sensors, synthetic_measurement
 
-    out, rows = {"jacobian": fitting.JACOBIAN}, []
+    out, rows = {"jacobian": fitting.JACOBIAN, "solver": fitting.FIT_SOLVER}, []
     noise = {"freq_noise": 0.0005, "shape_noise": 0.003}
     model = load_model(problem_file("ss-steel-beam.toml"))
     truth = model.with_effects([Effect("crack", {"position": 0.19, "depth_ratio": 0.5})])
@@ -368,7 +370,7 @@ def _fits_child(work: Path) -> dict:
     best, runs, d = _best_of(lambda: diagnose(real_model, real, realise=True), 1)
     out["diagnose_real"] = {"best_s": best, "verdict": d.verdict}
     rows += _diagnosis_rows("diagnose_real", d)
-    table = work / f"batch-{fitting.JACOBIAN}.csv"
+    table = work / f"batch-{fitting.JACOBIAN}-{fitting.FIT_SOLVER}.csv"
     sets = sorted((work / "sets").glob("*.json"))
     start = time.perf_counter()
     run_batch(problem_file("ss-steel-beam.toml"), work / "sets", table,
@@ -421,18 +423,42 @@ def _fits(out):
                                         shape_noise=0.003, freq_noise=0.0005, seed=5),
                   work / "mass-measured.json")
     sides = {}
-    for jacobian in ("difference", "analytic"):
-        env = {**os.environ, "GFE_OPT_JACOBIAN": jacobian}
-        run = subprocess.run([sys.executable, __file__, "--fits-child", jacobian, str(work)],
+    for side, (jacobian, solver) in FIT_SIDES.items():
+        env = {**os.environ, "GFE_OPT_JACOBIAN": jacobian, "GFE_OPT_FIT_SOLVER": solver}
+        run = subprocess.run([sys.executable, __file__, "--fits-child", side, str(work)],
                              capture_output=True, text=True, env=env, check=True)
-        sides[jacobian] = json.loads(run.stdout.strip().splitlines()[-1])
-        print(f"fits ({jacobian}): done", file=sys.stderr, flush=True)
+        sides[side] = json.loads(run.stdout.strip().splitlines()[-1])
+        print(f"fits ({side}): done", file=sys.stderr, flush=True)
     version = [sys.executable, "-m", "gfe_opt", "--version"]
     best, runs, _ = _best_of(lambda: subprocess.run(version, capture_output=True, check=True))
-    a, b = sides["difference"], sides["analytic"]
+    first = sides["difference"]
+    table = {}
+    for key, goal in (("diagnose_46", 0.5), ("diagnose_46_after_crack", 0.5),
+                      ("shell_diagnose_46", 1.2), ("diagnose_2000", 3.0), ("update_46", 0.1),
+                      ("batch_per_set", 0.15)):
+        field = "wall_s_per_set" if key == "batch_per_set" else "best_s"
+        table[key] = {f"{side}_s": round(sides[side][key][field], 3) for side in sides}
+        table[key].update(speedup=round(first[key][field] / sides["newton"][key][field], 2),
+                          goal_s=goal)
+    table["version_startup"] = {"best_s": round(best, 3), "goal_s": 0.3}
+    out["fits"] = {"table": table, "sides": {k: {"jacobian": j, "solver": v}
+                                             for k, (j, v) in FIT_SIDES.items()},
+                   "target_parameters": 1e-6, "target_chi2": 1e-9,
+                   "peak_rss_mb": {k: round(v["peak_rss_mb"], 1) for k, v in sides.items()}}
+    for side in ("analytic", "newton"):
+        out["fits"][f"{side}_against_difference"] = _fit_differences(first, sides[side])
+
+
+#: the sides of part 7: name -> (GFE_OPT_JACOBIAN, GFE_OPT_FIT_SOLVER)
+FIT_SIDES = {"difference": ("difference", "ipopt"), "analytic": ("analytic", "ipopt"),
+             "newton": ("analytic", "newton")}
+
+
+def _fit_differences(a, b) -> dict:
+    """Every fit of side ``b`` against its namesake of side ``a``: the largest relative
+    difference of the parameters, in σ (of ``a``), and of χ²; the verdicts."""
     worst_param, worst_sigma, worst_chi2 = 0.0, 0.0, 0.0
     pairs, differ = _matched_fits(a["fits"], b["fits"])
-    compared = len(pairs)
     for (_, va, sa, ca), (_, vb, _, cb) in pairs:
         for x, y, s in zip(va, vb, sa):
             worst_param = max(worst_param, abs(x - y) / max(abs(x), abs(y), 1e-300))
@@ -440,25 +466,12 @@ def _fits(out):
                 worst_sigma = max(worst_sigma, abs(x - y) / s)
         if np.isfinite(ca) and np.isfinite(cb):
             worst_chi2 = max(worst_chi2, abs(ca - cb) / max(abs(ca), abs(cb), 1e-300))
-    table = {}
-    for key, goal in (("diagnose_46", 0.5), ("diagnose_46_after_crack", 0.5),
-                      ("shell_diagnose_46", 1.2), ("diagnose_2000", 3.0), ("update_46", 0.1),
-                      ("batch_per_set", 0.15)):
-        field = "wall_s_per_set" if key == "batch_per_set" else "best_s"
-        table[key] = {"difference_s": round(a[key][field], 3),
-                      "analytic_s": round(b[key][field], 3),
-                      "speedup": round(a[key][field] / b[key][field], 2), "goal_s": goal}
-    table["version_startup"] = {"best_s": round(best, 3), "goal_s": 0.3}
-    out["fits"] = {"table": table,
-                   "fits_compared": compared,
-                   "fits_on_one_side_only": differ,
-                   "max_parameter_rel_difference": worst_param, "target_parameters": 1e-6,
-                   "max_parameter_difference_in_sigma": worst_sigma,
-                   "max_chi2_rel_difference": worst_chi2, "target_chi2": 1e-9,
-                   "verdicts": {k: (a[k].get("verdict"), b[k].get("verdict"))
-                                for k in a if isinstance(a[k], dict) and "verdict" in a[k]},
-                   "peak_rss_mb": {"difference": round(a["peak_rss_mb"], 1),
-                                   "analytic": round(b["peak_rss_mb"], 1)}}
+    return {"fits_compared": len(pairs), "fits_on_one_side_only": differ,
+            "max_parameter_rel_difference": worst_param,
+            "max_parameter_difference_in_sigma": worst_sigma,
+            "max_chi2_rel_difference": worst_chi2,
+            "verdicts": {k: (a[k].get("verdict"), b[k].get("verdict"))
+                         for k in a if isinstance(a[k], dict) and "verdict" in a[k]}}
 
 
 def _storey_measured(model):
@@ -487,16 +500,11 @@ def _storey_measured(model):
 
 
 def _frames_child(side: str) -> dict:
-    """One side of part 8, in this process."""
-    from gfe_opt import frame, frame_data
+    """One side of part 8 (the solver chosen by GFE_OPT_FIT_SOLVER), in this process."""
     from gfe_opt.diagnosis import diagnose
     from gfe_opt.frame_data import load_frame_measured
     from gfe_opt.problems import portal_frame, problem_file, three_storey_frame
 
-    if side == "old":
-        frame.DENSE_SOLVE_DOFS = 10**9
-        frame.FrameDiscretisation.dense_derivatives = None
-        frame_data.OBSERVATIONS_KEPT = 0
     noise = {"freq_noise": 0.0005, "shape_noise": 0.003}
     out, rows = {}, []
     portal = portal_frame()
@@ -519,27 +527,29 @@ def _frames_child(side: str) -> dict:
 
 def _frames(out):
     sides = {}
-    for side in ("old", "new"):
+    for side in ("ipopt", "newton"):
+        env = {**os.environ, "GFE_OPT_FIT_SOLVER": side}
         run = subprocess.run([sys.executable, __file__, "--frames-child", side],
-                             capture_output=True, text=True, check=True)
+                             capture_output=True, text=True, env=env, check=True)
         sides[side] = json.loads(run.stdout.strip().splitlines()[-1])
         print(f"frames ({side}): done", file=sys.stderr, flush=True)
-    a, b = sides["old"], sides["new"]
+    a, b = sides["ipopt"], sides["newton"]
     worst = 0.0
     pairs, differ = _matched_fits(a["fits"], b["fits"])
     for (_, va, _, _), (_, vb, _, _) in pairs:
         for x, y in zip(va, vb):
             worst = max(worst, abs(x - y) / max(abs(x), abs(y), 1e-300))
-    table = {key: {"old_s": round(a[key]["seconds"], 2), "new_s": round(b[key]["seconds"], 2),
+    table = {key: {"ipopt_s": round(a[key]["seconds"], 2),
+                   "newton_s": round(b[key]["seconds"], 2),
                    "speedup": round(a[key]["seconds"] / b[key]["seconds"], 2),
                    "verdicts": [a[key]["verdict"], b[key]["verdict"]],
-                   "found": b[key]["found"]}
+                   "found": b[key]["found"], "found_ipopt": a[key]["found"]}
              for key in ("portal_semirigid", "three_storey_floor_mass")}
     table["three_storey_floor_mass"]["goal_s"] = 5.0
     out["frames"] = {"table": table, "max_parameter_rel_difference": worst,
                      "fits_on_one_side_only": differ,
-                     "peak_rss_mb": {"old": round(a["peak_rss_mb"], 1),
-                                     "new": round(b["peak_rss_mb"], 1)}}
+                     "peak_rss_mb": {"ipopt": round(a["peak_rss_mb"], 1),
+                                     "newton": round(b["peak_rss_mb"], 1)}}
 
 
 if __name__ == "__main__":

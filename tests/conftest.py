@@ -65,4 +65,5 @@ def pytest_terminal_summary(terminalreporter):
     fitting = sys.modules.get("gfe_opt.fitting")
     if fitting is not None and fitting.SOLVER_TALLY:
         tally = dict(sorted(fitting.SOLVER_TALLY.items()))
-        terminalreporter.write_line(f"effect fits of this run (IPOPT status, finish): {tally}")
+        terminalreporter.write_line("effect fits of this run (finish outcome; IPOPT status "
+                                    f"where it ran): {tally}")

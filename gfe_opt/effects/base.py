@@ -408,6 +408,12 @@ class EffectType:
         itself)."""
         return z
 
+    def snap(self, model, variables: list[Variable], z):
+        """The effect with an edge that stopped short of an end moved onto it (started past
+        it, off the kink), where a fit may end as well with one parameter fewer; None when
+        there is no such edge (the default)."""
+        return None
+
     def to_variables(self, model, variables: list[Variable], params: dict) -> np.ndarray:
         out = []
         for v in variables:

@@ -172,6 +172,29 @@ class SectionLoss(EffectType):
         z[i], z[j] = (a + b) / 2, b - a
         return z
 
+    def snap(self, model, variables, z):
+        """A zone inside the structure whose nearer edge is closer to its end than the zone
+        is long: the zone from its inner edge to past that end (:data:`PAST_END`).  Damped
+        steps stop where the data no longer move an edge (near a pinned end a zone's last
+        millimetres carry almost no strain energy); on the end the zone is one parameter
+        fewer."""
+        ends = _on_ends(variables, z)
+        if ends is None or ends[2] or ends[3]:
+            return None
+        i, j = ends[:2]
+        a, b = z[i] - z[j] / 2, z[i] + z[j] / 2
+        if min(a, 1 - b) >= z[j]:
+            return None
+        if a < 1 - b:
+            a = -PAST_END
+        else:
+            b = 1 + PAST_END
+        if b - a > 1.0:
+            return None
+        z = np.array(z, dtype=float)
+        z[i], z[j] = (a + b) / 2, b - a
+        return z
+
     def frame_placeholders(self, model, params):
         span = model.member_length(model.member(params["member"]))
         return {"position": 0.5 * span, "length": 0.05 * span, "stiffness_ratio": 0.7,
