@@ -1,6 +1,7 @@
 """The gfe-opt command: compare table and JSON contract, exit codes, the demo."""
 
 import json
+import os
 import re
 import subprocess
 import sys
@@ -220,6 +221,31 @@ def test_startup_and_input_errors_load_no_solver_nor_plotting(files, argv):
     else:   # usage errors print their usage line first
         assert last.endswith(" 2") and out.stderr.strip().splitlines()[-1].startswith(
             "gfe-opt")
+
+
+def test_an_effect_fit_loads_no_casadi_and_ends_where_ipopt_first_did(files):
+    """Issue 22: `update --add crack` fits by damped Newton steps from the grid's start,
+    without loading CasADi (nor cvxpy, matplotlib); the old path (IPOPT to the valley, then
+    the same steps, ``GFE_OPT_FIT_SOLVER=ipopt``) ends at the same crack: both within their
+    stopping rule's 3e-5 σ of one optimum, so within 1e-3 σ of each other."""
+    model, measured, _ = files
+    code = ("import sys; from gfe_opt.entry import main; sys.argv[1:] = %r; rc = main(); "
+            "print('loaded', sorted(m for m in %r if m in sys.modules), rc)") % (
+        ["update", str(model), str(measured), "--add", "crack", "--json"], HEAVY)
+    out = {}
+    for solver in ("newton", "ipopt"):
+        run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             timeout=300, env={**os.environ, "GFE_OPT_FIT_SOLVER": solver})
+        assert run.returncode == 0 and "Traceback" not in run.stderr, run.stderr
+        *body, last = run.stdout.strip().splitlines()
+        out[solver] = (json.loads("\n".join(body)), last)
+    assert out["newton"][1] == "loaded [] 0"
+    assert "casadi" in out["ipopt"][1]
+    new, old = (out[s][0]["effects"][-1] for s in ("newton", "ipopt"))
+    for key in ("position", "depth_ratio"):
+        sigma = new["uncertainty"][key]
+        assert abs(new["parameters"][key] - old["parameters"][key]) < 1e-3 * sigma, key
+    assert abs(new["parameters"]["position"] - 0.4) < 3 * new["uncertainty"]["position"]
 
 
 def test_builtin_effect_names_are_the_registered_ones():
