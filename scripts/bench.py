@@ -457,17 +457,19 @@ FIT_SIDES = {"difference": ("difference", "ipopt"), "analytic": ("analytic", "ip
 def _fit_differences(a, b) -> dict:
     """Every fit of side ``b`` against its namesake of side ``a``: the largest relative
     difference of the parameters, in σ (of ``a``), and of χ²; the verdicts."""
-    worst_param, worst_sigma, worst_chi2 = 0.0, 0.0, 0.0
+    worst_param, worst_sigma, worst_chi2, where = 0.0, 0.0, 0.0, None
     pairs, differ = _matched_fits(a["fits"], b["fits"])
-    for (_, va, sa, ca), (_, vb, _, cb) in pairs:
+    for (label, va, sa, ca), (_, vb, _, cb) in pairs:
         for x, y, s in zip(va, vb, sa):
-            worst_param = max(worst_param, abs(x - y) / max(abs(x), abs(y), 1e-300))
+            rel = abs(x - y) / max(abs(x), abs(y), 1e-300)
+            if rel > worst_param:
+                worst_param, where = rel, label
             if np.isfinite(s) and s > 0:
                 worst_sigma = max(worst_sigma, abs(x - y) / s)
         if np.isfinite(ca) and np.isfinite(cb):
             worst_chi2 = max(worst_chi2, abs(ca - cb) / max(abs(ca), abs(cb), 1e-300))
     return {"fits_compared": len(pairs), "fits_on_one_side_only": differ,
-            "max_parameter_rel_difference": worst_param,
+            "max_parameter_rel_difference": worst_param, "worst_fit": where,
             "max_parameter_difference_in_sigma": worst_sigma,
             "max_chi2_rel_difference": worst_chi2,
             "verdicts": {k: (a[k].get("verdict"), b[k].get("verdict"))
