@@ -364,7 +364,7 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
                    thorough=False):
     """Fit one candidate from each of its starting points, keep the best.  ``given`` holds
     parameters the user fixed as starting values; ``extra`` effects are added first
-    (lookahead pairs); from frequencies alone IPOPT then runs from every start, ``seeds``
+    (lookahead pairs); from frequencies alone the fit then runs from every start, ``seeds``
     (the candidate's own fit alone) and profile starts included: two effects that trade
     against each other (a soft clamp, a tip mass) are found only by moving both.  On a
     frame each member as long as the best one is fitted again from the best one's place
@@ -407,7 +407,7 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
 def _fit_groups(model, measured, name, noise, starts, given, extra, seeds, thorough) -> list:
     """One fit per group of ``starts`` (and ``seeds``, with ``given`` over each) that share
     their fixed parameters (a frame's member): the group's first start and its others as
-    alternatives (the best grid point over them starts IPOPT)."""
+    alternatives (the best grid point over them starts the fit)."""
     kind = effect_type(name)
     groups = {}
     for start in [*starts, *seeds]:
@@ -1543,11 +1543,12 @@ class UpdateOutcome:
 def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
            shape_noise=None, drop=()) -> UpdateOutcome:
     """Add effect instances (names, ``name:key=value`` strings or :class:`Effect`) and fit
-    all of the model's effects' parameters with IPOPT.  The present instances are
-    re-estimated from where they are; an added one starts from the values given, the rest
-    from the diagnosis of that effect alone.  A global effect already in the model, or
-    added twice, is an error.  ``drop`` takes present instances out first (their index in
-    the model's effects, or a name the model holds once): a diagnosis's ``replace``."""
+    all of the model's effects' parameters (:func:`~gfe_opt.fitting.fit_effects`).  The
+    present instances are re-estimated from where they are; an added one starts from the
+    values given, the rest from the diagnosis of that effect alone.  A global effect already
+    in the model, or added twice, is an error.  ``drop`` takes present instances out first
+    (their index in the model's effects, or a name the model holds once): a diagnosis's
+    ``replace``."""
     noise = noise_of(freq_noise, shape_noise)
     if model.kind == "frame":   # sensors on a frame read through its mesh, per model
         dropped, C = [], None

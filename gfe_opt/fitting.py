@@ -596,9 +596,9 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     """Fit the parameters of the model's effects and of ``adding`` (effects whose given
     parameters are starting values; ``Effect(name, {})``: a grid chooses them).
     ``alternatives`` are further starting parameter sets of the last added effect (same
-    fixed parameters): the best grid point over all of them starts IPOPT.  When that
+    fixed parameters): the best grid point over all of them starts the fit.  When that
     fit of frequencies alone does not reach the noise (``multistart="auto"``; with shapes
-    the valleys are wide enough) or always (``True``), IPOPT runs
+    the valleys are wide enough) or always (``True``), the fit runs
     again from profile starts (:func:`_profile_starts`: effects that trade against each
     other, a soft clamp and a tip mass) and, with ``True``, from every alternative; the
     best end is kept, and ends that fit as well elsewhere are the fit's ``equivalent``.
@@ -639,7 +639,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
         ends.append(_minimise(residual, chi2, first, lower, upper, max_iter))
         if informed:
             # the added effect vanished at a grid's best point: its place there is no
-            # guess; IPOPT runs again from where the grid puts it when present (the best
+            # guess; the fit runs again from where the grid puts it when present (the best
             # such start).  Its end replaces the first when it converged lower by more than
             # the finish's own margin (FINISH_SETTLED floors): the same valley reached from
             # two starts is one end, which rounding must not choose
@@ -654,7 +654,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
             # effects that trade against each other (a soft clamp and a tip mass fitted
             # from frequencies: χ² rises 1e4-fold when the clamp alone moves 25 %) sit in a
             # narrow valley no coarse grid point hits: at each grid point of the last
-            # effect, a few Gauss-Newton steps move the others first; IPOPT runs from the
+            # effect, a few Gauss-Newton steps move the others first; the fit runs from the
             # best of those and from every start
             more = [s for s in starts if s is not first] if multistart is True else []
             more += _profile_starts(residual, chi2, first, grids, slots, lower, upper,
@@ -830,7 +830,8 @@ NEWTON_STEPS = 100
 #: are not determined by the data: their σ is 10⁴ times the best-determined one's (a zone at
 #: a clamp whose centre and length trade exactly shows 1e-6)
 FINISH_RANK = 1e-4
-#: IPOPT statuses and finish outcomes of the fits of this process (tests count them)
+#: finish outcomes (and IPOPT statuses where it runs) of this process's fits (tests count
+#: them)
 SOLVER_TALLY: Counter = Counter()
 
 
