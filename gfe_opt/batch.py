@@ -37,6 +37,7 @@ import io
 import json
 import math
 import os
+import shutil
 import signal
 import tempfile
 import time
@@ -97,7 +98,7 @@ def run_set(task: Task, name: str, data: bytes) -> dict:
            "model_sha1": task.model_sha1, "status": "ok", "error": None}
     serial, diagnosis.SERIAL_FITS = diagnosis.SERIAL_FITS, True
     try:
-        with tempfile.TemporaryDirectory(prefix="gfe-batch-") as tmp, \
+        with tempfile.TemporaryDirectory(prefix=f"{TEMP_PREFIX}{os.getpid()}-") as tmp, \
                 threadpool_limits(limits=1):
             model_path = Path(tmp) / Path(task.model_name).name
             model_path.write_text(task.model_text)
@@ -112,6 +113,37 @@ def run_set(task: Task, name: str, data: bytes) -> dict:
         diagnosis.SERIAL_FITS = serial
     row["seconds"] = round(time.perf_counter() - start, 3)
     return row
+
+
+#: a set's files lie in a temporary folder named with the worker's process id, so that a
+#: batch can remove the folders of workers that were killed mid-set (:func:`sweep_temp`)
+TEMP_PREFIX = "gfe-batch-"
+
+
+def sweep_temp(root=None) -> int:
+    """Remove this user's set folders (:data:`TEMP_PREFIX` + process id) left in ``root``
+    (default: the temporary directory) by processes that no longer run (a worker killed
+    mid-set cannot clean up); returns how many.  Folders of running processes, of other
+    users, and of any other name are left; on POSIX systems only."""
+    if os.name != "posix":   # os.kill(pid, 0) would end the process elsewhere
+        return 0
+    root = Path(tempfile.gettempdir() if root is None else root)
+    removed = 0
+    for path in root.glob(f"{TEMP_PREFIX}*-*"):
+        pid = path.name[len(TEMP_PREFIX):].split("-", 1)[0]
+        try:
+            if not pid.isdigit() or path.is_symlink() or not path.is_dir() \
+                    or path.stat().st_uid != os.getuid():
+                continue
+            os.kill(int(pid), 0)   # raises when no such process runs
+            continue
+        except ProcessLookupError:
+            pass
+        except (PermissionError, OSError):   # a process of another user, or unreadable
+            continue
+        shutil.rmtree(path, ignore_errors=True)
+        removed += 1
+    return removed
 
 
 def _solve(task: Task, model_path: Path, measured_path: Path, name: str) -> dict:
@@ -353,6 +385,7 @@ def run_batch(model_path, folder, out, *, add=(), scheduler=None, workers=None,
     task = Task(str(model_path), read_text(Path(model_path), "model"), tuple(add),
                 freq_noise, shape_noise, loop)
     files = measured_files(folder)
+    sweep_temp()   # set folders of workers killed in an earlier batch
     journal = journal_path(out)
     _check_batch_outputs(out, journal, [Path(model_path), *files])
     done = []

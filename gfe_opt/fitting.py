@@ -491,11 +491,6 @@ class Objective:
         point = self.point(z)
         return np.full(self.measured.n_values, FAILED_RESIDUAL) if point is None else point.r
 
-    def pairing(self, z) -> tuple | None:
-        """Which model mode each measured one is paired with at ``z`` (None: failed)."""
-        point = self.point(z)
-        return None if point is None else (tuple(point.rows), tuple(point.cols))
-
     def _analytic(self, z, r, lower, upper) -> np.ndarray:
         point = self.point(z)
         if point is not None:
@@ -887,22 +882,10 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     directions the data do not determine (singular values of J, its columns scaled to unit
     length, below :data:`FINISH_RANK` of the largest: a zone at a clamp whose centre and
     length trade exactly); their σ says so.  Returns (z, χ², the last decrement in noise
-    floors: 0 when nothing was left to fit, inf when the fit could not be evaluated).
-
-    A step that crosses into another pairing of the modes (``residual.pairing``, where the
-    residual has it) meets a jump of χ²: the best point of this pairing can lie on its
-    edge, where the decrement never falls and the damped steps shrink towards the edge,
-    each a tenth of the last, until the steps run out (a fit on a wrong member of a frame
-    spent 100 steps there).  When the smallest step rejected across the edge would, by the
-    step's own quadratic model, lower χ² by less than :data:`FINISH_SETTLED` noise floors,
-    the finish stops there, not converged (its decrement as it stands): the steps along
-    that path could not gain more, and the fit ends as it would have after its last
-    step."""
+    floors: 0 when nothing was left to fit, inf when the fit could not be evaluated)."""
     n = z.size
     r = residual(z)
     value = float(r @ r)
-    pairing = getattr(residual, "pairing", None)
-    paired = pairing(z) if pairing is not None else None
     if n == 0 or not np.isfinite(value) or value >= FAILED_RESIDUAL**2:
         return z, value, 0.0 if n == 0 else np.inf
     J = _jacobian(residual, z, r, lower, upper)
@@ -936,7 +919,6 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
             return z, value, decrement / floor
         shift = max(0.0, -lowest_eig) + 1e-12 * sv[0] ** 2   # H + shift: positive definite
         accepted = False
-        across = None   # the model decrease of the smallest step rejected across the edge
         while lam <= 1e10:
             try:
                 w = -np.linalg.solve(H + (shift + lam * sv[0] ** 2) * np.eye(H.shape[0]), gk)
@@ -950,11 +932,7 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
             if trial_value < value:
                 accepted = True
                 break
-            if paired is not None and pairing(trial) not in (None, paired):
-                across = -float(2 * gk @ w + w @ (H + shift * np.eye(H.shape[0])) @ w)
             lam = 1e-6 if lam == 0.0 else lam * 10.0
-        if across is not None and across < FINISH_SETTLED * floor:
-            return z, value, decrement / floor   # blocked on the edge of its pairing
         if not accepted and np.any(S):
             # no step lowers χ² with the secant term built up along the way (from a start far
             # off it may not fit here): Gauss–Newton again from this point
@@ -966,7 +944,6 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
         J_new = _jacobian(residual, trial, r_trial, lower, upper)
         S = _secant(S, (trial - z) * d, J / d, J_new / d, r_trial, g)
         z, r, value, J = trial, r_trial, trial_value, J_new
-        paired = pairing(z) if pairing is not None else None
     return z, value, decrement / floor
 
 

@@ -13,13 +13,23 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 import tomli_w
 
-from gfe_opt.batch import FIXED_COLUMNS, JOURNAL_HEADER, journal_path, read_table, run_batch
+from gfe_opt.batch import (
+    FIXED_COLUMNS,
+    JOURNAL_HEADER,
+    TEMP_PREFIX,
+    journal_path,
+    read_table,
+    run_batch,
+    sweep_temp,
+)
 from gfe_opt.cli import main
 from gfe_opt.fitting import misfit, noise_of
 from gfe_opt.measured import load_measured
@@ -110,6 +120,8 @@ def test_killed_batch_resumes_to_the_same_table(campaign, tmp_path):
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
     assert not out.exists()
+    # the set it was on left its folder (named with its process id); the resume sweeps it
+    left = list(Path(tempfile.gettempdir()).glob(f"{TEMP_PREFIX}{process.pid}-*"))
     lines = journal.read_text().splitlines()
     assert lines[0] == JOURNAL_HEADER
     done = len(lines) - 1
@@ -119,8 +131,22 @@ def test_killed_batch_resumes_to_the_same_table(campaign, tmp_path):
     result = run_batch(model_path, tmp / "sets", out, add=ADD, workers=2)
     assert result.skipped == done and result.ran == N_SETS - done
     assert not journal.exists()
+    assert not any(path.exists() for path in left)   # (when the kill fell inside a set)
     reference = _without_seconds(read_table(tmp / "reference.parquet"))
     assert _without_seconds(read_table(out)) == reference
+
+
+def test_set_folders_of_dead_workers_are_swept_and_no_others(tmp_path):
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    dead = tmp_path / f"{TEMP_PREFIX}{gone.stdout.strip()}-abc"
+    alive = tmp_path / f"{TEMP_PREFIX}{os.getpid()}-abc"
+    other = tmp_path / "gfe-batch-notapid-abc"
+    for path in (dead, alive, other):
+        path.mkdir()
+        (path / "model.toml").write_text("x")
+    assert sweep_temp(tmp_path) == 1
+    assert not dead.exists() and alive.exists() and other.exists()
 
 
 def test_dask_cluster_gives_the_same_table(campaign, tmp_path):

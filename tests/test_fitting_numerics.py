@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from gfe_opt.fitting import (FINISH_DECREMENT, FINISH_SETTLED, TIE, _finish, _grid_start,
-                              lowest, ranked)
+from gfe_opt.fitting import FINISH_DECREMENT, TIE, _finish, _grid_start, lowest, ranked
 from gfe_opt.modal import peak_rows
 
 T = np.linspace(0.0, 1.0, 12)
@@ -220,40 +219,3 @@ def test_the_combination_a_trade_leaves_told_has_the_sigma_the_data_give_it():
     ab = said[0]["ab"]
     assert ab["value"] == pytest.approx(2.0, rel=1e-12)
     assert ab["sigma"] == pytest.approx(1e-3, rel=0.05)
-
-
-class _Edged:
-    """The residual above with a second pairing of its 'modes' past b = ``edge`` (below the
-    optimum's b), where every residual is 30 larger: χ² jumps up across the edge, so the
-    best of the first pairing lies on its edge, where the gradient does not vanish."""
-
-    def __init__(self, edge, with_pairing=True):
-        self.edge = edge
-        if with_pairing:
-            self.pairing = lambda z: (0, 1) if z[1] <= self.edge else (1, 0)
-        self.count = 0
-
-    def __call__(self, z):
-        self.count += 1
-        return _residual(z) + (0.0 if z[1] <= self.edge else 30.0)
-
-
-def test_finish_stops_on_the_edge_of_its_pairing_as_the_creeping_steps_would():
-    """The steps towards an edge where the pairing changes shrink without end (each one
-    across it is rejected, the decrement stays large). With the residual's pairing known,
-    the finish stops once the step rejected across the edge would gain less than
-    FINISH_SETTLED noise floors by its own model: not converged, as the creeping steps end
-    after their budget, with a third of the evaluations or fewer and χ² within that
-    margin of where they end."""
-    best, _ = _reference_optimum()
-    edge = best[1] - 0.05
-    start = np.array([1.0, 0.0, 0.0])
-    edged = _Edged(edge)
-    z, value, decrement = _finish(edged, start, None, LOWER, UPPER, steps=100)
-    blind = _Edged(edge, with_pairing=False)
-    zb, blind_value, blind_decrement = _finish(blind, start, None, LOWER, UPPER, steps=100)
-    floor = value / (T.size - 3)
-    assert z[1] <= edge and zb[1] <= edge
-    assert decrement > FINISH_SETTLED and blind_decrement > FINISH_SETTLED  # not converged
-    assert 0.0 <= value - blind_value < FINISH_SETTLED * floor
-    assert 3 * edged.count <= blind.count
