@@ -361,7 +361,7 @@ def _candidates(model: Model, candidates) -> list[str]:
 
 
 def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), seeds=(),
-                   thorough=False):
+                   thorough=False, fits=None):
     """Fit one candidate from each of its starting points, keep the best.  ``given`` holds
     parameters the user fixed as starting values; ``extra`` effects are added first
     (lookahead pairs); from frequencies alone the fit then runs from every start, ``seeds``
@@ -370,10 +370,13 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
     frame each member as long as the best one is fitted again from the best one's place
     (:func:`_same_place_elsewhere`); with the member given (``update --add
     section_loss:member=left-column``), the other members of its length are fitted too, as
-    the places it is fitted again from, so that ``update`` ends where ``diagnose`` did."""
+    the places it is fitted again from, so that ``update`` ends where ``diagnose`` did.
+    ``fits``: the fits of its groups (:func:`_group_jobs`), when they ran as jobs of their
+    own."""
     kind = effect_type(name)
-    fits = _fit_groups(model, measured, name, noise, kind.starts(model, hint), given, extra,
-                       seeds, thorough)
+    if fits is None:
+        fits = _fit_groups(model, measured, name, noise, kind.starts(model, hint), given,
+                           extra, seeds, thorough)
     best = fits[0]
     for fit in fits[1:]:
         if _preferred(fit, best):
@@ -408,6 +411,11 @@ def _fit_groups(model, measured, name, noise, starts, given, extra, seeds, thoro
     """One fit per group of ``starts`` (and ``seeds``, with ``given`` over each) that share
     their fixed parameters (a frame's member): the group's first start and its others as
     alternatives (the best grid point over them starts the fit)."""
+    return [_fit_group(model, measured, name, noise, group, extra, thorough)
+            for group in _groups(name, starts, given, seeds)]
+
+
+def _groups(name, starts, given, seeds) -> list[list[dict]]:
     kind = effect_type(name)
     groups = {}
     for start in [*starts, *seeds]:
@@ -415,11 +423,38 @@ def _fit_groups(model, measured, name, noise, starts, given, extra, seeds, thoro
         key = repr({k: start.get(k) for k in kind.fixed_keys()})
         if start not in groups.setdefault(key, []):
             groups[key].append(start)
-    return [fit_effects(model, measured, [*extra, Effect(name, group[0])], noise=noise,
-                        name=name, alternatives=group[1:],
-                        multistart=True if (extra or thorough) and measured.frequency_only
-                        else "auto")
-            for group in groups.values()]
+    return list(groups.values())
+
+
+def _fit_group(model, measured, name, noise, group, extra, thorough):
+    return fit_effects(model, measured, [*extra, Effect(name, group[0])], noise=noise,
+                       name=name, alternatives=group[1:],
+                       multistart=True if (extra or thorough) and measured.frequency_only
+                       else "auto")
+
+
+def _candidate_args(payload) -> list:
+    """A candidate job's arguments with :func:`_fit_candidate`'s defaults filled in."""
+    defaults = [None, (), (), False]
+    return [*payload, *defaults[len(payload) - 5:]][:9]
+
+
+def _group_jobs(jobs):
+    """A frame's candidate jobs split into one job a group (a member), so that a candidate
+    with many members does not keep one core busy while the others wait: the jobs to run,
+    and for each the index of the job it came from."""
+    out, owner = [], []
+    for i, (kind, payload) in enumerate(jobs):
+        if kind != "candidate" or payload[0].kind != "frame":
+            out.append((kind, payload))
+            owner.append(i)
+            continue
+        model, measured, name, noise, hint, given, extra, seeds, thorough = \
+            _candidate_args(payload)
+        for group in _groups(name, effect_type(name).starts(model, hint), given, seeds):
+            out.append(("group", (model, measured, name, noise, group, extra, thorough)))
+            owner.append(i)
+    return out, owner
 
 
 def _fit_without(model, measured, noise, index):
@@ -494,7 +529,7 @@ def _job(args):
 
     kind, payload = args
     before = SOLVER_TALLY.copy()
-    result = {"profile": _fit_profile, "candidate": _fit_candidate,
+    result = {"profile": _fit_profile, "candidate": _fit_candidate, "group": _fit_group,
               "generic": _generic_only, "draw": _draw,
               "without": _fit_without}[kind](*payload)
     return result, SOLVER_TALLY - before
@@ -502,7 +537,31 @@ def _job(args):
 
 def _run_jobs(jobs, progress, labels):
     """Run fits, in parallel over the machine's cores (fork, one BLAS thread per worker;
-    serial where processes cannot be forked or only one core is there); results in order."""
+    serial where processes cannot be forked or only one core is there); results in order.
+    A frame's candidates run as a job a member first (:func:`_group_jobs`), then a job a
+    candidate that takes its members' fits on (:func:`_fit_candidate`, with ``fits``):
+    the same fits, the cores kept busy."""
+    split, owner = _group_jobs(jobs)
+    if len(split) == len(jobs):
+        return _pool_jobs(jobs, progress, labels)
+    first = _pool_jobs(split, progress, [labels[i] for i in owner])
+    results = [None] * len(jobs)
+    groups = [[] for _ in jobs]
+    for j, i in enumerate(owner):
+        if split[j][0] == "group":
+            groups[i].append(first[j])
+        else:
+            results[i] = first[j]
+    combine = sorted({i for j, i in enumerate(owner) if split[j][0] == "group"})
+    again = _pool_jobs([("candidate", (*_candidate_args(jobs[i][1]), groups[i]))
+                        for i in combine], None, [labels[i] for i in combine])
+    for i, fit in zip(combine, again):
+        results[i] = fit
+    return results
+
+
+def _pool_jobs(jobs, progress, labels):
+    """:func:`_run_jobs`'s jobs as they are, in the pool (or serially)."""
     workers = 1 if SERIAL_FITS else min(len(jobs), os.cpu_count() or 1)
     results = [None] * len(jobs)
     if progress:
