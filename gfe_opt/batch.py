@@ -139,7 +139,7 @@ def sweep_temp(root=None) -> int:
             continue
         except ProcessLookupError:
             pass
-        except (PermissionError, OSError):   # a process of another user, or unreadable
+        except OSError:   # a process of another user (PermissionError), or unreadable
             continue
         shutil.rmtree(path, ignore_errors=True)
         removed += 1
