@@ -23,6 +23,8 @@ Model file (``kind = "frame"``; README "Plane frames")::
                  effect = "support_spring": node, stiffness (N m/rad; a support's rotation)
                  effect = "support_translation": node, direction = "x" | "y", stiffness (N/m)
                  effect = "point_mass": member, position, mass (kg)
+                 effect = "point_spring": member, position, direction = "x" | "y",
+                          stiffness (N/m; a spring to ground along x or y there)
                  effect = "axial_stiffness": member, ratio;  effect = "material": E (Pa)
                  effect = "section_loss": member, position (the zone's centre), length (m),
                           stiffness_ratio (EI), mass_ratio (ρA and EA)
@@ -46,7 +48,8 @@ from .errors import GfeInputError
 
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
-                 "point_mass", "axial_stiffness", "material", "section_loss", "axial_load")
+                 "point_mass", "point_spring", "axial_stiffness", "material", "section_loss",
+                 "axial_load")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -320,6 +323,8 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
     member = model.member(member_id)
     if name == "point_mass":
         return _point_mass(model, member, raw, where, prefix)
+    if name == "point_spring":
+        return _point_spring(model, member, raw, where, prefix)
     if name == "axial_stiffness":
         no_unknown(raw, {"effect", "member", "ratio"}, where, prefix)
         ratio = _number(raw, "ratio", where, positive=True, prefix=prefix)
@@ -408,6 +413,33 @@ def _point_mass(model: FrameModel, member: Member, raw: dict, where: str, prefix
                        "mass": mass})
 
 
+def _point_spring(model: FrameModel, member: Member, raw: dict, where: str, prefix: str):
+    """A translational spring to ground on a member at ``position`` (m from its start; an
+    end is the joint there) along ``direction`` x or y (a wall or a brace it leans on, an
+    attachment), where no support holds that translation already."""
+    from .effects.base import no_unknown
+    from .model import _number
+
+    no_unknown(raw, {"effect", "member", "position", "direction", "stiffness"}, where, prefix)
+    length = model.member_length(member)
+    x = _number(raw, "position", where, prefix=prefix)
+    if not 0.0 <= x <= length:
+        raise GfeInputError(where, prefix + "position", f"must lie on the member [0, "
+                            f"{length:g}] m, got {x:g}")
+    d = raw.get("direction")
+    if d not in ("x", "y"):
+        raise GfeInputError(where, prefix + "direction", f"must be \"x\" or \"y\", got {d!r}")
+    k = _number(raw, "stiffness", where, positive=True, prefix=prefix)
+    end = member.start if x == 0.0 else member.end if x == length else None
+    support = dict(model.supports).get(end)
+    if RELEASES[d] in SUPPORT_TYPES.get(support, ()):
+        raise GfeInputError(where, prefix + "position", f"node {end!r} is a {support} support "
+                            f"that holds its translation along {d}: a spring there does "
+                            "nothing (a support that gives is a support_translation)")
+    return _as_effect({"effect": "point_spring", "member": member.id, "position": x,
+                       "direction": d, "stiffness": k})
+
+
 def _support_effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
     """A support that gives: its rotation (``support_spring``, N m/rad) or its translation
     along ``direction`` x or y (``support_translation``, N/m) held by a spring instead of
@@ -461,7 +493,7 @@ def check_repeats(effects, where) -> None:
 def _effect_key(effect) -> tuple | None:
     """What two instances of a frame effect may not share (a crack may repeat)."""
     e = {"effect": effect.name, **effect.parameters}
-    if e["effect"] in ("crack", "point_mass", "section_loss"):
+    if e["effect"] in ("crack", "point_mass", "point_spring", "section_loss"):
         return None
     if e["effect"] == "material":
         return ("material",)
@@ -840,18 +872,38 @@ def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
     K = _assemble(mesh, "K", np.concatenate([Ke.ravel(), springs,
                                              [k for _, k in mesh.grounded]]))
     M = _assemble(mesh, "M", Me.ravel())
-    masses = [e for e in model.raw_effects if e["effect"] == "point_mass"]
-    if masses:   # not the kept observations: a fitted mass moves at every evaluation
-        from .frame_data import build_observation as observation
-
-        # m (cx cxᵀ + cy cyᵀ): the mass moves with the member's x and y displacement at its
-        # place (the element's shape functions there, as a sensor reads them)
-        places = [{"member": e["member"], "position": e["position"], "direction": d}
-                  for e in masses for d in ("x", "y")]
-        C = observation(model, mesh, places)
-        m = np.repeat([e["mass"] for e in masses], 2)
+    masses = _attached(model, mesh, "point_mass")
+    if masses is not None:
+        C, m = masses
         M = M + (C.T @ sp.diags(m) @ C).tocsr()
+    points = _attached(model, mesh, "point_spring")
+    if points is not None:
+        C, k = points
+        K = K + (C.T @ sp.diags(k) @ C).tocsr()
     return K, M
+
+
+def _attached(model: FrameModel, mesh: FrameMesh, name: str):
+    """(C, values) of the frame's point masses (``name`` "point_mass": the x and the y
+    displacement at each, its mass twice) or point springs ("point_spring": the displacement
+    along its direction, its stiffness), None when it has none: each displacement read at
+    its place by the element's shape functions, as a sensor reads it, so that the mass adds
+    m (cx cxᵀ + cy cyᵀ) to M and the spring k c cᵀ to K.  Not kept with the mesh: a fitted
+    place moves at every evaluation."""
+    found = [e for e in model.raw_effects if e["effect"] == name]
+    if not found:
+        return None
+    from .frame_data import build_observation as observation
+
+    if name == "point_mass":
+        places = [{"member": e["member"], "position": e["position"], "direction": d}
+                  for e in found for d in ("x", "y")]
+        values = np.repeat([e["mass"] for e in found], 2)
+    else:
+        places = [{"member": e["member"], "position": e["position"],
+                   "direction": e["direction"]} for e in found]
+        values = np.array([float(e["stiffness"]) for e in found])
+    return observation(model, mesh, places), values
 
 
 def _assemble(mesh: FrameMesh, which: str, values) -> sp.csr_matrix:
@@ -1005,6 +1057,10 @@ def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:
         total = total + k * (shapes[a] - shapes[b]) ** 2
     for dof, k in mesh.grounded:
         total = total + k * shapes[dof] ** 2
+    points = _attached(model, mesh, "point_spring")
+    if points is not None:   # k (cᵀ φ)² each
+        C, k = points
+        total = total + k @ np.asarray(C @ shapes) ** 2
     return total
 
 

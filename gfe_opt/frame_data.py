@@ -527,10 +527,11 @@ def effect_place(model: FrameModel, effect) -> str:
     if "position" in p and "member" in p:
         m = model.member(p["member"])
         length = model.member_length(m)
+        along = f" in {p['direction']}" if "direction" in p else ""   # a point spring's
         for node, at in ((m.start, 0.0), (m.end, length)):
             if abs(p["position"] - at) <= 0.02 * length:
-                return f"node {node}"
-        return f"{m.id} at {p['position']:.3g} m"
+                return f"node {node}{along}"
+        return f"{m.id} at {p['position']:.3g} m{along}"
     if "node" in p:
         return f"node {p['node']}" + (f" in {p['direction']}" if "direction" in p else "")
     return str(p.get("member", "the frame"))
@@ -567,7 +568,8 @@ def _mark(model: FrameModel, name: str, params: dict):
     elif "position" in params:
         m = model.member(params["member"])
         point, _ = along(m.id, params["position"] / model.member_length(m))
-        label = f"{name} on {m.id} at {params['position']:.3g} m: {values}"
+        label = f"{name} on {m.id} at {params['position']:.3g} m" + (
+            f" in {params['direction']}" if "direction" in params else "") + f": {values}"
     elif name == "joint_spring":
         m = model.member(params["member"])
         t = 0.06 if params["node"] == m.start else 0.94

@@ -497,7 +497,8 @@ def frame_localisation(members, points, residual, worst, labels):
 #: load is its member drawn over in colour)
 FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "support_spring": ("D", "tab:brown"), "support_translation": ("D", "tab:brown"),
-               "point_mass": ("s", "tab:purple"), "axial_stiffness": (None, "tab:blue"),
+               "point_mass": ("s", "tab:purple"), "point_spring": ("^", "tab:green"),
+               "axial_stiffness": (None, "tab:blue"),
                "axial_load": (None, "tab:cyan")}
 
 

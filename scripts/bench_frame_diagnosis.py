@@ -30,7 +30,11 @@ drawn from the seed:
   was pinned in (a turnbuckle): every member's axial force from the exact static solution
   (the brace pulls 20 to 200 N, 2.5 to 25 % of its Euler load; the portal's members push
   back), each carried by the exact frame's member (EI w⁗ − T w″); the answer an
-  ``axial_load`` of the brace, its size the brace's force.
+  ``axial_load`` of the brace, its size the brace's force;
+* ``lean``: a spring to ground across a member drawn at random (a column leaning on a
+  wall, a prop under the beam), 10 to 90 % along it, 10 to 300 times the member's EI/L³
+  (the exact frame with the member split at the spring); the answer a ``point_spring`` on
+  that member in that direction within 2 % of its length, its size the stiffness.
 
 Noise 1 to 2.5 times 0.3 % shape / 0.05 % frequency, stated (its true level) in half the
 cases.  The loop is the beam campaign's (``bench_diagnosis.follow``): ``diagnose``; while
@@ -84,7 +88,8 @@ from gfe_opt.problems import portal_frame  # noqa: E402
 from tests.frame_reference import ExactFrame, self_stress, zone_frame  # noqa: E402
 from tests.test_frame_diagnosis import NOISE, _braced_portal, _exact, _guess, _measured, _sensors  # noqa: E402
 
-CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material", "zone", "tension")
+CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material", "zone", "tension",
+           "lean")
 POSITION_TOLERANCE = 0.02
 DETECTABLE = 2.0     # first chi2/n at the stated noise below which a change is noise
 
@@ -169,6 +174,8 @@ def make_case(seed: int, group: str) -> dict:
         answers = [{"name": "material", "size": model.E * (scale - 1.0), "base": model.E}]
     elif group == "zone":
         exact, where, answers, bracket = _zone(model, rng)
+    elif group == "lean":
+        exact, where, answers, bracket = _lean(model, rng)
     elif group == "tension":
         model = _braced_portal()
         members = [(m.start, m.end, m.E, m.rho, m.area, m.inertia) for m in model.members]
@@ -217,13 +224,35 @@ def _zone(model, rng):
     return exact, where, answers, bracket
 
 
+def _lean(model, rng):
+    """A spring to ground across a member drawn at random (a column leaning on a wall, a
+    prop under the beam), 10 to 90 % along it, 10 to 300 times the member's EI/L³ (its own
+    stiffness across is 24 to 192 times that, from a sway to a clamped span): the exact
+    frame with the member split there and the spring at the cut."""
+    member = model.members[int(rng.integers(len(model.members)))]
+    L = model.member_length(member)
+    a = float(rng.uniform(0.1, 0.9)) * L
+    (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
+    direction = "x" if abs(x1 - x0) < abs(y1 - y0) else "y"     # across the member
+    k = _log_uniform(rng, 10.0, 300.0) * member.E * member.inertia / L**3
+    exact, where = zone_frame(model, member.id, a, a, 1.0, 1.0,
+                              [("Z1", (1.0, 0.0) if direction == "x" else (0.0, 1.0), k)])
+    bracket = [Effect("point_spring", {"member": member.id, "position": a,
+                                       "direction": direction, "stiffness": k})]
+    answers = [{"name": "point_spring", "member": member.id, "position": a, "length": L,
+                "direction": direction, "size": k}]
+    return exact, where, answers, bracket
+
+
 def _matches(model, effect: Effect, answer: dict) -> bool:
     p = effect.parameters
     if effect.name != answer["name"]:
         return False
     if answer["name"] in ("joint_spring", "support_spring"):
         return p.get("node") == answer["node"]
-    if answer["name"] in ("crack", "section_loss"):
+    if answer["name"] == "point_spring" and p.get("direction") != answer["direction"]:
+        return False
+    if answer["name"] in ("crack", "section_loss", "point_spring"):
         return p.get("member") == answer["member"] and abs(
             p["position"] - answer["position"]) <= POSITION_TOLERANCE * answer["length"]
     if answer["name"] == "axial_load":

@@ -67,14 +67,19 @@ class ExactFrame:
     """A frame of uniform members: ``nodes`` {id: (x, y)}, ``members`` [(from, to, E, rho,
     A, I)], ``supports`` {id: type}, ``joint_springs`` [(node, member index, k)],
     ``member_ids`` the members' names (for sensors on them), ``ground_springs`` [(node, DOF
-    0/1/2 for u/v/θ, k)]: a support's fixity of that DOF replaced by a spring to ground;
+    0/1/2 for u/v/θ, k)]: a support's fixity of that DOF replaced by a spring to ground
+    (a direction (cx, cy) for the DOF: a spring to ground along it at a node left free);
     ``masses`` [(node, kg)]: a rigid mass at a node (it moves in x and y)."""
 
     def __init__(self, nodes, members, supports, joint_springs=(), member_ids=None,
                  ground_springs=(), masses=()):
         self.ids = list(nodes)
         self.masses = [(3 * self.ids.index(node) + d, m) for node, m in masses for d in (0, 1)]
-        self.ground = [(3 * self.ids.index(node) + dof, k) for node, dof, k in ground_springs]
+        self.ground = [(3 * self.ids.index(node) + dof, k) for node, dof, k in ground_springs
+                       if not isinstance(dof, tuple)]
+        # a spring to ground along a direction (cx, cy) at a node no support holds there
+        self.leaning = [(3 * self.ids.index(node), np.array(dof, dtype=float), k)
+                        for node, dof, k in ground_springs if isinstance(dof, tuple)]
         self.member_ids = list(member_ids or range(len(members)))
         self.nodes = nodes
         self.members = members
@@ -114,6 +119,8 @@ class ExactFrame:
             D[np.ix_([i, j], [i, j])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
         for i, k in self.ground:
             D[i, i] += k
+        for i, d, k in self.leaning:
+            D[i:i + 2, i:i + 2] += k * np.outer(d, d)
         for i, m in self.masses:
             D[i, i] -= omega**2 * m
         return D[np.ix_(self.free, self.free)] / self.scale
@@ -248,18 +255,19 @@ def self_stress(nodes, members, supports, shortened, strain) -> list[float]:
                   + locked) for dofs, c, s, stiffness, locked in axes]
 
 
-def zone_frame(model, member_id, a, b, stiffness_ratio, area_ratio):
+def zone_frame(model, member_id, a, b, stiffness_ratio, area_ratio, ground_springs=()):
     """The exact frame of ``model`` (a :class:`~gfe_opt.frame.FrameModel`, read for its
     geometry and sections only) with member ``member_id`` split at a and b (m from its start;
-    either may be an end) and the part between them of I × ``stiffness_ratio`` and A ×
-    ``area_ratio`` (EA and ρA with it), and ``where``, which maps a sensor of the model to
-    the split frame's (its parts are named ``<member>-0``, ``-1`` ...)."""
+    either may be an end; b = a: one cut) and the part between them of I ×
+    ``stiffness_ratio`` and A × ``area_ratio`` (EA and ρA with it), and ``where``, which maps
+    a sensor of the model to the split frame's (its parts are named ``<member>-0``, ``-1``
+    ...).  ``ground_springs`` as :class:`ExactFrame`'s (the cut at a is node ``Z1``)."""
     member = next(m for m in model.members if m.id == member_id)
     (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
     L = math.hypot(x1 - x0, y1 - y0)
     nodes, members, names = dict(model.nodes), [], []
     cuts = [(0.0, member.start)]
-    for t, name in ((a, "Z1"), (b, "Z2")):
+    for t, name in ((a, "Z1"), (b, "Z2"))[:1 if b == a else 2]:
         # a part shorter than 1e-3 of the member is its end (the exact member's end
         # conditions lose rank as its length goes to 0: a draw 1e-6 from an end failed)
         if 1e-3 * L < t < (1 - 1e-3) * L:
@@ -285,4 +293,4 @@ def zone_frame(model, member_id, a, b, stiffness_ratio, area_ratio):
         return {**sensor, "member": f"{member_id}-{i}",
                 "position": sensor["position"] - starts[i]}
 
-    return ExactFrame(nodes, members, dict(model.supports), (), names), where
+    return ExactFrame(nodes, members, dict(model.supports), (), names, ground_springs), where

@@ -9,6 +9,7 @@ from .base import (
     Parameter,
     Variable,
     check_not_on_support,
+    frame_position_variable,
     nominal_rigidity,
     position_variable,
 )
@@ -24,8 +25,12 @@ class PointSpring(EffectType):
     name = "point_spring"
     physics = "a translational spring to ground at one point"
     signature = "a local rise of the coefficient of w (u) at one node"
-    kinds = ("beam", "bar")
+    kinds = ("beam", "bar", "frame")
     local = True
+    frame_parameters = (Parameter("member", "", "choice", "the member (a frame; position "
+                                  "from its start node, an end is the joint)"),
+                        Parameter("direction", "", "choice", "x or y (a frame)",
+                                  choices=("x", "y")))
     parameters = (
         Parameter("position", "m", "position", "distance from the left end"),
         Parameter("stiffness", "N/m", "positive", "spring stiffness", null=0.0),
@@ -39,12 +44,21 @@ class PointSpring(EffectType):
         build.add_point_stiffness(params["position"], params["stiffness"])
 
     def variables(self, model, fixed):
+        if model.kind == "frame":
+            return _frame_variables(model, model.member(fixed["member"]), fixed["direction"])
         return [position_variable(model),
                 Variable("stiffness", -3.0, 5.0, (0.0, 1.0, 2.0, 3.0, 4.0), log=True,
                          scale=_scale)]
 
     def starts(self, model, hint):
+        if model.kind == "frame":   # along every member, in x and in y
+            return [{"member": m.id, "direction": d} for m in model.members
+                    for d in ("x", "y")]
         return [{}, {"position": hint * model.length, "stiffness": 10.0 * _scale(model)}]
+
+    def frame_placeholders(self, model, params):
+        return {"position": 0.5 * model.member_length(model.member(params["member"])),
+                "stiffness": 1.0}
 
     def mark(self, ax, model, params, sigma, y, bounds=None):
         x = params["position"]
@@ -53,6 +67,21 @@ class PointSpring(EffectType):
         ax.annotate(f"{at_least}{params['stiffness']:.3g} N/m", (x, y),
                     textcoords="offset points",
                     xytext=(0, 9), ha="center", fontsize=7, color="tab:green")
+
+
+def _frame_variables(model, member, direction):
+    """x / member length (the grid's 19 interior places and each end whose node no support
+    holds along ``direction``) and the stiffness in units of the member's EI/ℓ³, the same
+    range and grid as on a beam."""
+    from ..frame import RELEASES, SUPPORT_TYPES
+
+    supports = dict(model.supports)
+    ends = tuple(float(t) for t, node in ((0, member.start), (1, member.end))
+                 if RELEASES[direction] not in SUPPORT_TYPES.get(supports.get(node), ()))
+    own = member.E * member.inertia / model.member_length(member) ** 3
+    return [frame_position_variable(model, member, ends),
+            Variable("stiffness", -3.0, 5.0, (0.0, 1.0, 2.0, 3.0, 4.0), log=True,
+                     scale=lambda m: own)]
 
 
 EFFECT = PointSpring()
