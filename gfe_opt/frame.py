@@ -30,8 +30,8 @@ Model file (``kind = "frame"``; README "Plane frames")::
                           stiffness_ratio (EI), mass_ratio (ρA and EA)
 
 Frames have modes (:func:`frame_modes`, ``gfe-opt modes``), are compared with tests
-(:mod:`gfe_opt.frame_data`) and go through the beam's fits (:class:`FrameDiscretisation`:
-``update --add joint_spring``); diagnosing them is the next part of the issue.
+(:mod:`gfe_opt.frame_data`), go through the beam's fits (:class:`FrameDiscretisation`:
+``update --add joint_spring``) and its diagnosis (:mod:`gfe_opt.diagnosis`).
 """
 
 from __future__ import annotations

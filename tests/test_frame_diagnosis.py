@@ -230,6 +230,41 @@ def test_a_crack_near_a_column_base_is_found_on_that_column_at_its_place():
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
+def test_a_column_leaning_on_a_wall_is_a_point_spring_there():
+    """The left column held across (x) at 40 % of its height by a spring to ground of 30
+    times its EI/L³ (a wall it touches, a brace to the next frame): the exact frame with the
+    column cut there.  Before frames took point springs, a section loss and a support
+    spring stood in for it (a confident wrong answer); now the diagnosis names a point spring
+    on that column, in x, within 2 % of its length, the stiffness within 10 %, drawn and
+    printed at its place; after it the model agrees."""
+    model = portal_frame()
+    column = model.member("left-column")
+    L = model.member_length(column)
+    k, a = 30 * column.E * column.inertia / L**3, 0.4 * L
+    exact, where = zone_frame(model, "left-column", a, a, 1.0, 1.0, [("Z1", (1.0, 0.0), k)])
+    bracket = [Effect("point_spring", {"member": "left-column", "position": a,
+                                       "direction": "x", "stiffness": k})]
+    measured = _measured(model, exact, _guess(model, bracket), _sensors(model), 4, where)
+    d = _diagnose(model, measured, **NOISE)
+    assert d.verdict == "effect_found" and d.suggested == ["point_spring"], d.notes
+    found = d.best.effects[0].parameters
+    assert (found["member"], found["direction"]) == ("left-column", "x")
+    assert abs(found["position"] - a) < 0.02 * L
+    assert found["stiffness"] == pytest.approx(k, rel=0.1)
+    assert d.add_arguments() == ["point_spring:member=left-column,direction=x"]
+    from gfe_opt.frame_data import effect_place
+    from gfe_opt.report import diagnosis_figures
+
+    place = f"left-column at {found['position']:.3g} m in x"
+    assert effect_place(model, d.best.effects[0]) == place
+    frame_axes, listing = diagnosis_figures(d, model)["frame_diagnosis.png"].axes
+    assert any(t.get_text().startswith(
+        f"1: point_spring on left-column at {found['position']:.3g} m in x: stiffness "
+        f"{found['stiffness']:.3g} N/m") for t in listing.texts)
+    after = update(model, measured, d.add_arguments(), **NOISE)
+    assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
+
+
 @pytest.mark.parametrize("start, end, ratio, seed", [
     (0.21, 0.29, 1.6, 5),    # a doubler plate inside the beam
     pytest.param(0.0, 0.06, 2.5, 6, marks=pytest.mark.slow),   # a haunch at joint B
