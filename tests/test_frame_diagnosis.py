@@ -236,7 +236,8 @@ def test_a_column_leaning_on_a_wall_is_a_point_spring_there():
     column cut there.  Before frames took point springs, a section loss and a support
     spring stood in for it (a confident wrong answer); now the diagnosis names a point spring
     on that column, in x, within 2 % of its length, the stiffness within 10 %, drawn and
-    printed at its place; after it the model agrees."""
+    printed at its place.  (That the model agrees after it, the loop's end, is the frame
+    campaign's ``lean`` class: 8 cases a seed, every member, across it.)"""
     model = portal_frame()
     column = model.member("left-column")
     L = model.member_length(column)
@@ -261,8 +262,6 @@ def test_a_column_leaning_on_a_wall_is_a_point_spring_there():
     assert any(t.get_text().startswith(
         f"1: point_spring on left-column at {found['position']:.3g} m in x: stiffness "
         f"{found['stiffness']:.3g} N/m") for t in listing.texts)
-    after = update(model, measured, d.add_arguments(), **NOISE)
-    assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
 @pytest.mark.parametrize("start, end, ratio, seed", [
