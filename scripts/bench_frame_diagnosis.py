@@ -306,7 +306,7 @@ def run_case(case: dict) -> dict:
             if answer["name"] != "crack":
                 size_err.append(100 * ((_size(case["model"], hit) - answer.get("base", 0.0))
                                        / answer["size"] - 1))
-            if answer["name"] in ("crack", "section_loss"):
+            if answer["name"] in ("crack", "section_loss", "point_spring"):
                 pos_err.append(100 * abs(hit.parameters["position"] - answer["position"])
                                / answer["length"])
     undetectable = bool(case["answers"] and case["stated"] and first_chi2 < DETECTABLE
