@@ -391,6 +391,19 @@ def _section_loss(model: FrameModel, member: Member, raw: dict, where: str, pref
     return _as_effect(out)
 
 
+def _member_place(model: FrameModel, member: Member, raw: dict, where: str, prefix: str):
+    """A point effect's ``position`` (m from the member's start), checked to lie on the
+    member, and the node it sits on (an end: the joint there; None between them)."""
+    from .model import _number
+
+    length = model.member_length(member)
+    x = _number(raw, "position", where, prefix=prefix)
+    if not 0.0 <= x <= length:
+        raise GfeInputError(where, prefix + "position", f"must lie on the member [0, "
+                            f"{length:g}] m, got {x:g}")
+    return x, (member.start if x == 0.0 else member.end if x == length else None)
+
+
 def _point_mass(model: FrameModel, member: Member, raw: dict, where: str, prefix: str):
     """A mass on a member at ``position`` (m from its start; an end is the joint there),
     held by neither support translation of its place."""
@@ -398,13 +411,8 @@ def _point_mass(model: FrameModel, member: Member, raw: dict, where: str, prefix
     from .model import _number
 
     no_unknown(raw, {"effect", "member", "position", "mass"}, where, prefix)
-    length = model.member_length(member)
-    x = _number(raw, "position", where, prefix=prefix)
-    if not 0.0 <= x <= length:
-        raise GfeInputError(where, prefix + "position", f"must lie on the member [0, "
-                            f"{length:g}] m, got {x:g}")
+    x, end = _member_place(model, member, raw, where, prefix)
     mass = _number(raw, "mass", where, positive=True, prefix=prefix)
-    end = member.start if x == 0.0 else member.end if x == length else None
     support = dict(model.supports).get(end)
     if {0, 1} <= set(SUPPORT_TYPES.get(support, ())):
         raise GfeInputError(where, prefix + "position", f"node {end!r} is a {support} support "
@@ -421,16 +429,11 @@ def _point_spring(model: FrameModel, member: Member, raw: dict, where: str, pref
     from .model import _number
 
     no_unknown(raw, {"effect", "member", "position", "direction", "stiffness"}, where, prefix)
-    length = model.member_length(member)
-    x = _number(raw, "position", where, prefix=prefix)
-    if not 0.0 <= x <= length:
-        raise GfeInputError(where, prefix + "position", f"must lie on the member [0, "
-                            f"{length:g}] m, got {x:g}")
+    x, end = _member_place(model, member, raw, where, prefix)
     d = raw.get("direction")
     if d not in ("x", "y"):
         raise GfeInputError(where, prefix + "direction", f"must be \"x\" or \"y\", got {d!r}")
     k = _number(raw, "stiffness", where, positive=True, prefix=prefix)
-    end = member.start if x == 0.0 else member.end if x == length else None
     support = dict(model.supports).get(end)
     if RELEASES[d] in SUPPORT_TYPES.get(support, ()):
         raise GfeInputError(where, prefix + "position", f"node {end!r} is a {support} support "

@@ -227,6 +227,17 @@ def frame_member_scale(model, node: str, power: int) -> float:
     return m.E * m.inertia / model.member_length(m) ** power
 
 
+def frame_free_ends(model, member, held) -> tuple:
+    """The ends of a frame ``member`` (0.0 its start, 1.0 its end) where an effect acting on
+    the DOFs ``held`` (0 x, 1 y) does something: those whose node no support holds in every
+    one of them."""
+    from ..frame import SUPPORT_TYPES
+
+    supports = dict(model.supports)
+    return tuple(float(t) for t, node in ((0, member.start), (1, member.end))
+                 if not set(held) <= set(SUPPORT_TYPES.get(supports.get(node), ())))
+
+
 def frame_position_variable(model, member, ends=()) -> Variable:
     """A place along a frame ``member``: x / its length in [0, 1], grid at 19 interior
     places (and ``ends``, 0 or 1, where the effect may sit on a joint)."""

@@ -8,6 +8,7 @@ from .base import (
     Parameter,
     Variable,
     check_not_on_support,
+    frame_free_ends,
     frame_position_variable,
     position_variable,
 )
@@ -60,11 +61,7 @@ class PointMass(EffectType):
 def _frame_variables(model, member):
     """x / member length (the grid's 19 interior places and each end whose node no
     support holds in both translations) and the mass in units of the member's own."""
-    from ..frame import SUPPORT_TYPES
-
-    supports = dict(model.supports)
-    ends = tuple(float(t) for t, node in ((0, member.start), (1, member.end))
-                 if not {0, 1} <= set(SUPPORT_TYPES.get(supports.get(node), ())))
+    ends = frame_free_ends(model, member, (0, 1))
     own = member.rho * member.area * model.member_length(member)
     return [frame_position_variable(model, member, ends),
             Variable("mass", 1e-4, 3.0, (0.05, 0.2, 0.5), scale=lambda m: own)]

@@ -9,6 +9,7 @@ from .base import (
     Parameter,
     Variable,
     check_not_on_support,
+    frame_free_ends,
     frame_position_variable,
     nominal_rigidity,
     position_variable,
@@ -73,11 +74,9 @@ def _frame_variables(model, member, direction):
     """x / member length (the grid's 19 interior places and each end whose node no support
     holds along ``direction``) and the stiffness in units of the member's EI/ℓ³, the same
     range and grid as on a beam."""
-    from ..frame import RELEASES, SUPPORT_TYPES
+    from ..frame import RELEASES
 
-    supports = dict(model.supports)
-    ends = tuple(float(t) for t, node in ((0, member.start), (1, member.end))
-                 if RELEASES[direction] not in SUPPORT_TYPES.get(supports.get(node), ()))
+    ends = frame_free_ends(model, member, (RELEASES[direction],))
     own = member.E * member.inertia / model.member_length(member) ** 3
     return [frame_position_variable(model, member, ends),
             Variable("stiffness", -3.0, 5.0, (0.0, 1.0, 2.0, 3.0, 4.0), log=True,
