@@ -52,9 +52,9 @@ class PointSpring(EffectType):
                          scale=_scale)]
 
     def starts(self, model, hint):
-        if model.kind == "frame":   # along every member, in x and in y
+        if model.kind == "frame":   # along every member, across it (x and y if inclined)
             return [{"member": m.id, "direction": d} for m in model.members
-                    for d in ("x", "y")]
+                    for d in across_directions(model, m)]
         return [{}, {"position": hint * model.length, "stiffness": 10.0 * _scale(model)}]
 
     def frame_placeholders(self, model, params):
@@ -68,6 +68,19 @@ class PointSpring(EffectType):
         ax.annotate(f"{at_least}{params['stiffness']:.3g} N/m", (x, y),
                     textcoords="offset points",
                     xytext=(0, 9), ha="center", fontsize=7, color="tab:green")
+
+
+def across_directions(model, member) -> tuple[str, ...]:
+    """The directions of ``x`` and ``y`` not along ``member``'s axis (both on an inclined
+    member).  A spring along a member's axis at a place inside it moves with the member's
+    axial motion, uniform along it to within the spring's k/(EA/ℓ): it cannot be told from
+    the same spring at the member's end joint, where the members meeting it at an angle
+    hold it across their axes.  Such a spring is fitted when asked for by name
+    (``--add point_spring:member=beam,direction=x``)."""
+    (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
+    along = {"x": abs(y1 - y0) <= 1e-12 * abs(x1 - x0),
+             "y": abs(x1 - x0) <= 1e-12 * abs(y1 - y0)}
+    return tuple(d for d in ("x", "y") if not along[d])
 
 
 def _frame_variables(model, member, direction):
