@@ -181,9 +181,13 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("--plot", metavar="DIR", help="write the stabilisation chart into DIR")
     i.add_argument("--force", action="store_true", help="overwrite existing output files")
 
-    d = sub.add_parser("demo", help="the whole story on a synthetic cracked beam")
-    d.add_argument("--out", default="gfe-opt-demo",
-                   help="folder for the demo's files (default %(default)s)")
+    d = sub.add_parser("demo", help="the whole story on a synthetic cracked beam (--frame: "
+                       "on a portal frame with semi-rigid joints)")
+    d.add_argument("--frame", action="store_true",
+                   help="the portal frame's demo instead of the beam's")
+    d.add_argument("--out", default=None,
+                   help="folder for the demo's files (default gfe-opt-demo, with --frame "
+                        "gfe-opt-frame-demo)")
     d.add_argument("--force", action="store_true", help="overwrite the demo's own files")
     return parser
 
@@ -532,7 +536,8 @@ def cmd_trend(args) -> int:
 def cmd_demo(args) -> int:
     from .demo import run_demo
 
-    return run_demo(Path(args.out), force=args.force)
+    out = args.out or ("gfe-opt-frame-demo" if args.frame else "gfe-opt-demo")
+    return run_demo(Path(out), force=args.force, frame=args.frame)
 
 
 def _version() -> str:

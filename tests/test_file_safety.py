@@ -133,6 +133,17 @@ def test_demo_refuses_the_users_figures_without_force(tmp_path, capsys):
     assert sorted(p.name for p in out.rglob("*")) == ["error.png", "figures", "mac.png"]
 
 
+def test_the_frame_demo_refuses_the_users_frame_figure_before_any_work(tmp_path, capsys):
+    """``demo --frame`` keeps its own list of files (the frame's figures among them) and
+    refuses, before any work, one it did not write."""
+    out = tmp_path / "framedemo"
+    (out / "figures").mkdir(parents=True)
+    (out / "figures" / "frame_modes.png").write_text(VICTIM_TEXT)
+    assert main(["demo", "--frame", "--out", str(out)]) == 2
+    assert "frame_modes.png: exists and is not as the demo wrote it" in _err(capsys)
+    assert sorted(p.name for p in out.rglob("*")) == ["figures", "frame_modes.png"]
+
+
 def test_demo_force_refuses_a_folder_where_it_writes_a_file(tmp_path, capsys):
     out = tmp_path / "d"
     (out / "model.toml").mkdir(parents=True)
