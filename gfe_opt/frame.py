@@ -49,7 +49,7 @@ from .errors import GfeInputError
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
                  "point_mass", "point_spring", "axial_stiffness", "material", "section_loss",
-                 "axial_load")
+                 "axial_load", "foundation")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -334,6 +334,10 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
         return _as_effect({"effect": name, "member": member_id, "ratio": ratio})
     if name == "section_loss":
         return _section_loss(model, member, raw, where, prefix)
+    if name == "foundation":
+        no_unknown(raw, {"effect", "member", "stiffness"}, where, prefix)
+        return _as_effect({"effect": name, "member": member_id, "stiffness": _number(
+            raw, "stiffness", where, positive=True, prefix=prefix)})
     if name == "axial_load":
         no_unknown(raw, {"effect", "member", "tension"}, where, prefix)
         return _as_effect({"effect": name, "member": member_id,
@@ -483,7 +487,7 @@ def _as_effect(raw: dict):
 
 def check_repeats(effects, where) -> None:
     """One joint spring a member end, one support effect a node and direction, one axial
-    stiffness and one axial load a member, one material."""
+    stiffness, one axial load and one foundation a member, one material."""
     seen = {}
     for i, e in enumerate(effects):
         key = _effect_key(e)
@@ -500,7 +504,7 @@ def _effect_key(effect) -> tuple | None:
         return None
     if e["effect"] == "material":
         return ("material",)
-    if e["effect"] in ("axial_stiffness", "axial_load"):
+    if e["effect"] in ("axial_stiffness", "axial_load", "foundation"):
         return (e["effect"], e["member"]) if "member" in e else None
     if "node" not in e:
         return None   # --add without a place: every place is tried
@@ -678,20 +682,22 @@ def _zoned_elements(zones, step: float, count: int) -> list[int]:
 
 #: the effects that change a member's elements (the others act at joints, supports and
 #: places: springs, masses, applied in :func:`frame_matrices`)
-_ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness", "axial_load")
+_ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness", "axial_load", "foundation")
 
 
 @dataclass(frozen=True)
 class MemberElements:
     """One member's elements: bending parameters k_ww, k_wθ, k_θθ (n, 3) [N m²], axial
     rigidity EA (n,) [N], stiffness and mass matrices (n, 6, 6) in global axes (the
-    stiffness with the geometric stiffness of the member's ``tension``, N, > 0 pulling)."""
+    stiffness with the geometric stiffness of the member's ``tension``, N, > 0 pulling, and
+    its ``foundation``'s k_f ∫ w² dx, N/m²)."""
 
     bending: np.ndarray
     axial: np.ndarray
     K: np.ndarray
     M: np.ndarray
     tension: float = 0.0
+    foundation: float = 0.0
 
 
 #: members' elements computed, by everything that decides them (:func:`_member_key`): a fit
@@ -834,18 +840,31 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     if tension:   # geometric stiffness T ∫ N'ᵀN' dx of the transverse motion
         local_k[np.ix_(range(n), bend, bend)] += tension * slope_gram(L[0]) \
             * scaling[:, :, None] * scaling[:, None, :]
+    foundation = _member_value(model, member, "foundation", "stiffness")
+    if foundation:   # k_f ∫ NᵀN dx of the transverse motion (the beam's foundation)
+        local_k[np.ix_(range(n), bend, bend)] += foundation * L[0] * _TRANSVERSE_GRAM \
+            * scaling[:, :, None] * scaling[:, None, :]
     zones = _zones(model, member.id)
     for j, start, x, w in _zoned_quadrature(zones, L[0], n):
         local_m[j] += _zone_mass(zones, rhoA[j], start, L[0], x, w)
     T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
     Tt = np.swapaxes(T, 1, 2)
-    return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension)
+    return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension, foundation)
+
+
+#: ∫ NᵀN dx / L of the Hermite element in scaled DOFs [w₁, Lθ₁, w₂, Lθ₂]
+_TRANSVERSE_GRAM = el.symmetric_beam_mass(**el.CONSISTENT_BEAM_MASS)
 
 
 def _member_tension(model: FrameModel, member: Member) -> float:
     """The axial force of an ``axial_load`` on ``member`` [N] (tension > 0), else 0."""
-    return float(next((e["tension"] for e in model.raw_effects
-                       if e["effect"] == "axial_load" and e["member"] == member.id), 0.0))
+    return _member_value(model, member, "axial_load", "tension")
+
+
+def _member_value(model: FrameModel, member: Member, effect: str, key: str) -> float:
+    """``key`` of the (one) ``effect`` on ``member``, else 0."""
+    return float(next((e[key] for e in model.raw_effects
+                       if e["effect"] == effect and e["member"] == member.id), 0.0))
 
 
 def element_matrices(model: FrameModel):
@@ -1055,6 +1074,11 @@ def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:
         q = np.stack([v1, L * u[:, 2], v2, L * u[:, 5]], axis=1)      # (n_el, 4, modes)
         gram = slope_gram(1.0) * 30.0                                  # 30 L ∫ N'ᵀN' (scaled)
         energy = energy + (T[:, None] / (30.0 * L)) * np.einsum("eim,ij,ejm->em", q, gram, q)
+    kf = np.concatenate([np.full(m.axial.size, m.foundation) for m in members])
+    if np.any(kf):   # a member's foundation: k_f ∫ w² dx
+        q = np.stack([v1, L * u[:, 2], v2, L * u[:, 5]], axis=1)
+        energy = energy + (kf[:, None] * L) * np.einsum("eim,ij,ejm->em", q,
+                                                        _TRANSVERSE_GRAM, q)
     total = energy.sum(axis=0)
     for a, b, k in mesh.springs:
         total = total + k * (shapes[a] - shapes[b]) ** 2

@@ -15,6 +15,10 @@ EI w⁗ − T w″ = ρAω² w, whose solutions are cos βx, sin βx, cosh αx, 
 the roots of EI s² − T s − ρAω² = 0, and whose transverse end forces gain T w′
 (F₁ = EI w‴(0) − T w′(0), F₂ = −EI w‴(L) + T w′(L)).  :func:`self_stress` gives the forces
 a member's prestrain (a turnbuckle) sets up in a frame, by the exact static stiffness.
+
+A member may lie on a Winkler foundation k_f [N/m²] (an eighth entry; the seventh, its axial
+force, then given, 0 for none): EI w⁗ − T w″ + (k_f − ρAω²) w = 0, solved by exp(r x) over
+the four (complex) roots r, below the foundation's own frequency √(k_f/ρA) as above it.
 """
 
 from __future__ import annotations
@@ -37,9 +41,10 @@ def _wavenumbers(E, rho, A, inertia, omega, tension=0.0):
     return math.sqrt((root - tension) / (2 * EI)), math.sqrt((root + tension) / (2 * EI))
 
 
-def member_dynamic_stiffness(E, rho, A, inertia, L, omega, tension=0.0) -> np.ndarray:
+def member_dynamic_stiffness(E, rho, A, inertia, L, omega, tension=0.0,
+                             foundation=0.0) -> np.ndarray:
     """(6, 6) dynamic stiffness in the member's axes, DOFs u₁, v₁, θ₁, u₂, v₂, θ₂ (with a
-    constant axial force ``tension``, N)."""
+    constant axial force ``tension``, N, and a Winkler ``foundation``, N/m²)."""
     D = np.zeros((6, 6))
     k = omega * math.sqrt(rho / E)
     if k * L < 1e-8:
@@ -49,18 +54,38 @@ def member_dynamic_stiffness(E, rho, A, inertia, L, omega, tension=0.0) -> np.nd
                                                          [-1.0, math.cos(k * L)]])
     D[np.ix_([0, 3], [0, 3])] = axial
     EI = E * inertia
-    beta, alpha = _wavenumbers(E, rho, A, inertia, omega, tension)
+    basis = _transverse(E, rho, A, inertia, omega, tension, foundation)
 
     def derivs(x):
         """w, w′, w″, w‴ of the four basis functions at x (rows)."""
-        return np.array([_basis(beta, x, order, alpha) for order in range(4)])
+        return np.array([basis(x, order) for order in range(4)])
 
     d0, d1 = derivs(0.0), derivs(L)
     B = np.array([d0[0], d0[1], d1[0], d1[1]])
     F = np.array([EI * d0[3] - tension * d0[1], -EI * d0[2],
                   -EI * d1[3] + tension * d1[1], EI * d1[2]])
-    D[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = F @ np.linalg.inv(B)
+    bending = F @ np.linalg.inv(B)
+    if np.iscomplexobj(bending):   # complex exponentials: a real matrix, to rounding
+        assert np.max(np.abs(bending.imag)) <= 1e-8 * np.max(np.abs(bending.real))
+        bending = bending.real
+    D[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = bending
     return D
+
+
+def _transverse(E, rho, A, inertia, omega, tension=0.0, foundation=0.0):
+    """The four solutions of a member's transverse motion at ω as ``basis(t, order)`` (their
+    derivatives of ``order`` at t): cos βt, sin βt, cosh αt, sinh αt (:func:`_basis`); on a
+    foundation exp(r t) for the four roots r of EI r⁴ − T r² + k_f − ρAω² = 0 (complex
+    where the foundation holds the member above its inertia), distinct but at isolated
+    frequencies."""
+    if foundation == 0.0:
+        beta, alpha = _wavenumbers(E, rho, A, inertia, omega, tension)
+        return lambda t, order: _basis(beta, t, order, alpha)
+    EI = E * inertia
+    disc = np.sqrt(complex(tension**2 - 4.0 * EI * (foundation - rho * A * omega**2)))
+    squares = [(tension + disc) / (2 * EI), (tension - disc) / (2 * EI)]
+    roots = np.array([sign * np.sqrt(r2) for r2 in squares for sign in (1.0, -1.0)])
+    return lambda t, order: roots**order * np.exp(roots * t)
 
 
 class ExactFrame:
@@ -113,7 +138,8 @@ class ExactFrame:
             T = np.zeros((6, 6))
             T[:3, :3], T[3:, 3:] = R, R
             dofs = self._member_dofs(k)
-            Dm = member_dynamic_stiffness(E, rho, A, inertia, L, omega, _tension(m))
+            Dm = member_dynamic_stiffness(E, rho, A, inertia, L, omega, _tension(m),
+                                          _foundation(m))
             D[np.ix_(dofs, dofs)] += T.T @ Dm @ T
         for i, j, k in self.springs:
             D[np.ix_([i, j], [i, j])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
@@ -189,11 +215,11 @@ class ExactFrame:
             x = s["position"]
             ka = w * math.sqrt(rho / E)
             axial = (u1 * math.sin(ka * (L - x)) + u2 * math.sin(ka * x)) / math.sin(ka * L)
-            beta, alpha = _wavenumbers(E, rho, A, inertia, w, _tension(self.members[k]))
-            B = np.array([_basis(beta, 0, 0, alpha), _basis(beta, 0, 1, alpha),
-                          _basis(beta, L, 0, alpha), _basis(beta, L, 1, alpha)])
+            basis = _transverse(E, rho, A, inertia, w, _tension(self.members[k]),
+                                _foundation(self.members[k]))
+            B = np.array([basis(0, 0), basis(0, 1), basis(L, 0), basis(L, 1)])
             coef = np.linalg.solve(B, [v1, g[2], v2, g[5]])
-            transverse = _basis(beta, x, 0, alpha) @ coef
+            transverse = float(np.real(basis(x, 0) @ coef))
             out.append(direction @ (R.T @ np.array([axial, transverse])))
         return np.array(out)
 
@@ -213,6 +239,11 @@ def _basis(beta, t, order, alpha=None):
 def _tension(member) -> float:
     """A member tuple's axial force (its seventh entry; 0 without one)."""
     return float(member[6]) if len(member) > 6 else 0.0
+
+
+def _foundation(member) -> float:
+    """A member tuple's foundation modulus k_f (its eighth entry; 0 without one)."""
+    return float(member[7]) if len(member) > 7 else 0.0
 
 
 def member_static_stiffness(E, A, inertia, L) -> np.ndarray:
