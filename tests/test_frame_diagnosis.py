@@ -636,3 +636,39 @@ def test_a_beam_resting_on_a_foundation_is_a_foundation_under_that_beam():
     after = update(model, measured, d.add_arguments(), **NOISE)
     assert after.model.effects[0].parameters["stiffness"] == pytest.approx(
         found["stiffness"], rel=1e-4)
+
+
+@pytest.mark.slow   # 80 s each: the loop, two diagnoses and an update
+@pytest.mark.parametrize("case", ["mass and joint", "support and joint"])
+def test_two_different_changes_are_found_together_and_then_the_portal_agrees(case):
+    """Two unrelated changes at once, exact (no gfe-opt element), outside the frame
+    campaign's classes (one change each): 0.15 kg at joint C with the beam's end at B
+    loose (3000 N m/rad), or base A turning against 800 N m/rad with the beam's end at C
+    loose (4000).  The loop names both at their places within 5 % and ends consistent."""
+    from gfe_opt.diagnosis import follow
+
+    model = portal_frame()
+    members = [(m.start, m.end, m.E, m.rho, m.area, m.inertia) for m in model.members]
+    beam, ids = [m.id for m in model.members].index("beam"), [m.id for m in model.members]
+    if case == "mass and joint":
+        exact = ExactFrame(model.nodes, members, dict(model.supports), [("B", beam, 3000.0)],
+                           ids, (), [("C", 0.15)])
+        truth = [Effect("joint_spring", {"node": "B", "member": "beam", "stiffness": 3000.0}),
+                 Effect("point_mass", {"member": "beam", "position": 0.4, "mass": 0.15})]
+    else:
+        exact = ExactFrame(model.nodes, members, dict(model.supports), [("C", beam, 4000.0)],
+                           ids, [("A", 2, 800.0)])
+        truth = [Effect("joint_spring", {"node": "C", "member": "beam", "stiffness": 4000.0}),
+                 Effect("support_spring", {"node": "A", "stiffness": 800.0})]
+    measured = _measured(model, exact, _guess(model, truth), _sensors(model), 7)
+    out = follow(model, measured, **NOISE)
+    assert out.verdicts[-1] == "consistent", out.verdicts
+    assert sorted(e.name for e in out.model.effects) == sorted(e.name for e in truth)
+    for t in truth:
+        e = next(e for e in out.model.effects if e.name == t.name)
+        if "node" in t.parameters:
+            assert e.parameters["node"] == t.parameters["node"]
+        else:   # the mass at joint C: the beam's end (or the right column's top)
+            assert e.parameters["member"] in ("beam", "right-column")
+        size = next(k for k in ("stiffness", "mass") if k in t.parameters)
+        assert e.parameters[size] == pytest.approx(t.parameters[size], rel=0.05)
