@@ -164,18 +164,9 @@ def _run_demo(out: Path) -> int:
     print(f"   the hidden truth was: crack at x = {DEMO_CRACK['position']} m, "
           f"a/d = {DEMO_CRACK['depth_ratio']}")
     print("\n6. Check: diagnose the updated model; nothing significant should be left.\n")
-    again = diagnose(outcome.model, measured, progress=terminal_progress(True), **NOISE)
-    left = again.best
-    print("   nothing significant is left: " + again.verdict if left is None else
-          f"   still significant: {left.describe()}")
-    try:
-        figures = [compare_figures(result, model), diagnosis_figures(diagnosis, model),
-                   {"error.png": error_history([
-                       ("initial model", outcome.before.freq_error_rms_pct),
-                       (f"+ {best.effect}", outcome.after.freq_error_rms_pct)])}]
-    except ImportError as exc:
-        print(f"\n(no figures or report: {exc})")
-        figures = None
+    _check(outcome.model, measured, **NOISE)
+    figures = _story_figures(lambda: compare_figures(result, model), diagnosis, model,
+                             outcome, best.effect)
     if figures is not None:
         _write_report(out, report_path, figures, result, diagnosis, outcome, best, model,
                       model_path, measured_path, updated_path)
@@ -187,6 +178,27 @@ def _run_demo(out: Path) -> int:
           f"--out {updated_path} --force\n"
           f"  gfe-opt diagnose {updated_path} {measured_path}")
     return 0
+
+
+def _check(model, measured, **noise) -> None:
+    """Step 6: the updated model diagnosed again, and what is left said in one line."""
+    again = diagnose(model, measured, progress=terminal_progress(True), **noise)
+    left = again.best
+    print("   nothing significant is left: " + again.verdict if left is None else
+          f"   still significant: {left.describe()}")
+
+
+def _story_figures(compared, diagnosis, model, outcome, label):
+    """The demo's figures: ``compared()``'s, the diagnosis's and the error before and after
+    adding ``label``; None (said in a line) where matplotlib is missing."""
+    try:
+        return [compared(), diagnosis_figures(diagnosis, model),
+                {"error.png": error_history([
+                    ("initial model", outcome.before.freq_error_rms_pct),
+                    (f"+ {label}", outcome.after.freq_error_rms_pct)])}]
+    except ImportError as exc:
+        print(f"\n(no figures or report: {exc})")
+        return None
 
 
 def _write_report(out, report_path, figures, result, diagnosis, outcome, best, model,
@@ -269,21 +281,9 @@ def _run_frame_demo(out: Path) -> int:
           "be left.\n")
     after = compare_frame(outcome.model, measured)
     print(_indent(format_frame_comparison(after)) + "\n")
-    again = diagnose(outcome.model, measured, progress=terminal_progress(True))
-    left = again.best
-    print("   nothing significant is left: " + again.verdict if left is None else
-          f"   still significant: {left.describe()}")
-    try:
-        from .report import diagnosis_figures
-
-        label = " + ".join(e.name for e in outcome.model.effects)
-        figures = [frame_figures(result, model, measured), diagnosis_figures(diagnosis, model),
-                   {"error.png": error_history([
-                       ("initial model", outcome.before.freq_error_rms_pct),
-                       (f"+ {label}", outcome.after.freq_error_rms_pct)])}]
-    except ImportError as exc:
-        print(f"\n(no figures or report: {exc})")
-        figures = None
+    _check(outcome.model, measured)
+    figures = _story_figures(lambda: frame_figures(result, model, measured), diagnosis, model,
+                             outcome, " + ".join(e.name for e in outcome.model.effects))
     if figures is not None:
         save_figures({k: v for f in figures for k, v in f.items()}, out / "figures")
         report = Report("gfe-opt demo: a portal frame with semi-rigid joints")
