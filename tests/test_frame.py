@@ -532,9 +532,11 @@ def test_cli_modes_writes_the_frame_contract_and_diagnose_reads_it(
                           str(out), "--json"], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr   # its own modes: nothing is missing
     assert json.loads(run.stdout)["verdict"] == "consistent"
+    # the figures and the refusal to overwrite them: two candidates are enough (the full
+    # diagnosis of these modes ran above)
     run = subprocess.run([sys.executable, "-m", "gfe_opt", "diagnose", str(model),
-                          str(out), "--plot", str(tmp_path / "figs")],
-                         capture_output=True, text=True)
+                          str(out), "--plot", str(tmp_path / "figs"), "--candidates",
+                          "material,joint_spring"], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert {p.name for p in (tmp_path / "figs").iterdir()} >= {"frame_diagnosis.png"}
     again = subprocess.run([sys.executable, "-m", "gfe_opt", "diagnose", str(model),
