@@ -347,8 +347,8 @@ def test_a_foundation_under_a_member_converges_to_the_exact_frame_on_it(member, 
     own √(k_f/ρA) as above it; no gfe-opt element in it).  Cubic elements: the largest
     frequency error falls as h⁴ (observed rate between 16 and 32 elements a member 3.7 to
     4.3) to below 3e-7 at 64; no frequency falls, and the modes that bend the member rise
-    by percent.  The modes' strain energy holds k_f ∫ w²: the Rayleigh quotients are the
-    eigenvalues."""
+    by percent.  The frequencies are the Rayleigh quotients of the element-wise strain
+    energy (gfe_opt.modal), so the match checks its k_f ∫ w² term too."""
     base = portal_frame()
     m = base.member(member)
     L = base.member_length(m)
@@ -404,8 +404,8 @@ def test_a_spring_along_a_member_is_the_same_spring_at_its_end_joint():
     at 0.3 of its length, a spring of 100 EI/L³ gives the frequencies of that spring at
     joint B (the left column's top, across it) but for the beam's axial give between
     them: within k ℓ/EA = 4e-3 (8e-4 measured); across the beam it moves them by up to
-    60 %.  The starts are
-    the directions across each member, both on an inclined brace."""
+    60 %.  The starts are the directions across each member, both on an inclined
+    brace."""
     from gfe_opt.effects import effect_type
 
     base = portal_frame()
