@@ -272,7 +272,8 @@ def _run_frame_demo(out: Path) -> int:
         print(f"\nNothing to add: {diagnosis.verdict}.")
         _mark_demo_folder(out, FRAME_DEMO_FILES)
         return 0
-    print("\n5. Add it: update --add " + " --add ".join(add) + "\n")
+    print(f"\n5. Add {'them' if len(add) > 1 else 'it'}: update --add "
+          + " --add ".join(add) + "\n")
     outcome = update(model, measured, add)
     save_model(outcome.model, updated_path, force=True, protect=(model_path, measured_path))
     print(_indent(format_update(outcome)))
