@@ -474,3 +474,9 @@ def flexibility_parameters(s, c, L):
     f2 = np.sum(c * s * s, axis=-1)
     det = f2 * f0 - f1 * f1
     return L**3 * f0 / det, L**2 * f1 / det, L * f2 / det
+
+
+#: ∫ N Nᵀ dx / L of the cubic Hermite element in scaled DOFs [w₁, Lθ₁, w₂, Lθ₂]: the
+#: consistent mass per ρAL, and a Winkler foundation's stiffness per k_f L (beam and frame)
+HERMITE_GRAM = symmetric_beam_mass(**CONSISTENT_BEAM_MASS)
+HERMITE_GRAM.flags.writeable = False

@@ -842,7 +842,7 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
             * scaling[:, :, None] * scaling[:, None, :]
     foundation = _member_value(model, member, "foundation", "stiffness")
     if foundation:   # k_f ∫ NᵀN dx of the transverse motion (the beam's foundation)
-        local_k[np.ix_(range(n), bend, bend)] += foundation * L[0] * _TRANSVERSE_GRAM \
+        local_k[np.ix_(range(n), bend, bend)] += foundation * L[0] * el.HERMITE_GRAM \
             * scaling[:, :, None] * scaling[:, None, :]
     zones = _zones(model, member.id)
     for j, start, x, w in _zoned_quadrature(zones, L[0], n):
@@ -850,10 +850,6 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
     Tt = np.swapaxes(T, 1, 2)
     return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension, foundation)
-
-
-#: ∫ NᵀN dx / L of the Hermite element in scaled DOFs [w₁, Lθ₁, w₂, Lθ₂]
-_TRANSVERSE_GRAM = el.symmetric_beam_mass(**el.CONSISTENT_BEAM_MASS)
 
 
 def _member_tension(model: FrameModel, member: Member) -> float:
@@ -1070,15 +1066,15 @@ def strain_energy(model: FrameModel, mesh: FrameMesh, shapes) -> np.ndarray:
     energy = (EA[:, None] / L) * axial**2 + (p[:, 0, None] * d1**2 + 2 * p[:, 1, None] * d1 * d2
                                              + p[:, 2, None] * d2**2) / L**3
     T = np.concatenate([np.full(m.axial.size, m.tension) for m in members])
-    if np.any(T):   # a member's axial load: T ∫ w'² dx, w' from [v₁, Lθ₁, v₂, Lθ₂]
+    kf = np.concatenate([np.full(m.axial.size, m.foundation) for m in members])
+    if np.any(T) or np.any(kf):   # transverse motion [v₁, Lθ₁, v₂, Lθ₂] of each element
         q = np.stack([v1, L * u[:, 2], v2, L * u[:, 5]], axis=1)      # (n_el, 4, modes)
+    if np.any(T):   # a member's axial load: T ∫ w'² dx
         gram = slope_gram(1.0) * 30.0                                  # 30 L ∫ N'ᵀN' (scaled)
         energy = energy + (T[:, None] / (30.0 * L)) * np.einsum("eim,ij,ejm->em", q, gram, q)
-    kf = np.concatenate([np.full(m.axial.size, m.foundation) for m in members])
     if np.any(kf):   # a member's foundation: k_f ∫ w² dx
-        q = np.stack([v1, L * u[:, 2], v2, L * u[:, 5]], axis=1)
-        energy = energy + (kf[:, None] * L) * np.einsum("eim,ij,ejm->em", q,
-                                                        _TRANSVERSE_GRAM, q)
+        energy = energy + (kf[:, None] * L) * np.einsum("eim,ij,ejm->em", q, el.HERMITE_GRAM,
+                                                        q)
     total = energy.sum(axis=0)
     for a, b, k in mesh.springs:
         total = total + k * (shapes[a] - shapes[b]) ** 2

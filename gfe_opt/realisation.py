@@ -75,7 +75,7 @@ def beam_row(order: int = 6):
     r"""The translational row at node i of two generic beam elements with eq. 13 stiffness
     from a smooth k(x) and the consistent mass of a smooth m(x) (uniform within each element,
     taken at the element centre), times L³.  The paper's eq. 12 is its L⁴ term."""
-    from .elements import CONSISTENT_BEAM_MASS, symmetric_beam_mass
+    from .elements import HERMITE_GRAM
     from .parameterisation import derive_nodal_coefficients
 
     c = derive_nodal_coefficients()
@@ -91,7 +91,7 @@ def beam_row(order: int = 6):
 
     kl_ww, kl_wt, _ = element_params(-1)   # left element, node i is its node 2
     kr_ww, kr_wt, _ = element_params(0)    # right element, node i is its node 1
-    mass = np.array(symmetric_beam_mass(**CONSISTENT_BEAM_MASS))
+    mass = np.array(HERMITE_GRAM)
     mass = sympy.Matrix(4, 4, [sympy.nsimplify(v) for v in mass.ravel()])
     m_left = shift(m(x), sympy.Rational(-1, 2), order)
     m_right = shift(m(x), sympy.Rational(1, 2), order)

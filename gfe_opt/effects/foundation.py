@@ -25,8 +25,7 @@ class Foundation(EffectType):
 
     def contribute(self, model, params, build):
         k = params["stiffness"]
-        shape = el.symmetric_beam_mass(**el.CONSISTENT_BEAM_MASS)  # ∫ N Nᵀ dx / L
-        build.add_element_stiffness(lambda L: k * L * shape)
+        build.add_element_stiffness(lambda L: k * L * el.HERMITE_GRAM)
 
     def variables(self, model, fixed):
         """k_f over EI (π/ℓ)⁴ of the beam or of the member (its first pinned-pinned mode's
