@@ -28,6 +28,8 @@ Model file (``kind = "frame"``; README "Plane frames")::
                  effect = "axial_stiffness": member, ratio;  effect = "material": E (Pa)
                  effect = "section_loss": member, position (the zone's centre), length (m),
                           stiffness_ratio (EI), mass_ratio (ρA and EA)
+                 effect = "shear": shear_rigidity (N; κGA of the first member, every
+                          member's κGA its GA over the first's times it: Timoshenko members)
 
 Frames have modes (:func:`frame_modes`, ``gfe-opt modes``), are compared with tests
 (:mod:`gfe_opt.frame_data`), go through the beam's fits (:class:`FrameDiscretisation`:
@@ -49,7 +51,7 @@ from .errors import GfeInputError
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
                  "point_mass", "point_spring", "axial_stiffness", "material", "section_loss",
-                 "axial_load", "foundation")
+                 "axial_load", "foundation", "shear")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -317,6 +319,10 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
         E = _number(raw, "E", where, positive=True, prefix=prefix)
         effect_type(name).check(model, {"E": E}, where, prefix)   # the beams' range, one rule
         return _as_effect({"effect": name, "E": E})
+    if name == "shear":   # every member Timoshenko: κGA is the first member's
+        no_unknown(raw, {"effect", "shear_rigidity"}, where, prefix)
+        return _as_effect({"effect": name, "shear_rigidity": _number(
+            raw, "shear_rigidity", where, positive=True, prefix=prefix)})
     member_id = _ident(raw, "member", where, prefix)
     if member_id not in {m.id for m in model.members}:
         raise GfeInputError(where, prefix + "member", f"no member {member_id!r}")
@@ -502,8 +508,8 @@ def _effect_key(effect) -> tuple | None:
     e = {"effect": effect.name, **effect.parameters}
     if e["effect"] in ("crack", "point_mass", "point_spring", "section_loss"):
         return None
-    if e["effect"] == "material":
-        return ("material",)
+    if e["effect"] in ("material", "shear"):
+        return (e["effect"],)
     if e["effect"] in ("axial_stiffness", "axial_load", "foundation"):
         return (e["effect"], e["member"]) if "member" in e else None
     if "node" not in e:
@@ -690,7 +696,9 @@ class MemberElements:
     """One member's elements: bending parameters k_ww, k_wθ, k_θθ (n, 3) [N m²], axial
     rigidity EA (n,) [N], stiffness and mass matrices (n, 6, 6) in global axes (the
     stiffness with the geometric stiffness of the member's ``tension``, N, > 0 pulling, and
-    its ``foundation``'s k_f ∫ w² dx, N/m²)."""
+    its ``foundation``'s k_f ∫ w² dx, N/m²); a Timoshenko member's (a ``shear`` effect)
+    bending parameters are its shear-softened ones (eq. 18) and ``shear_g`` each element's
+    g = 12 EI / (κGA L²) (None: Euler–Bernoulli)."""
 
     bending: np.ndarray
     axial: np.ndarray
@@ -698,6 +706,7 @@ class MemberElements:
     M: np.ndarray
     tension: float = 0.0
     foundation: float = 0.0
+    shear_g: np.ndarray | None = None
 
 
 #: members' elements computed, by everything that decides them (:func:`_member_key`): a fit
@@ -710,7 +719,7 @@ _MEMBER_ELEMENTS_KEPT = 256
 def _member_key(model: FrameModel, k: int, raw: list) -> tuple:
     m = model.members[k]
     return (m, tuple(model.nodes[m.start]), tuple(model.nodes[m.end]), model.stiffness_factor,
-            tuple(tuple(e.items()) for e in raw
+            shear_rigidity(model), tuple(tuple(e.items()) for e in raw
                   if e["effect"] in _ELEMENT_EFFECTS and e["member"] == m.id))
 
 
@@ -724,8 +733,9 @@ def member_elements(model: FrameModel) -> list[MemberElements]:
         kept = _MEMBER_ELEMENTS.get(key)
         if kept is None:
             kept = _member_elements(model, k)
-            for array in (kept.bending, kept.axial, kept.K, kept.M):
-                array.flags.writeable = False
+            for array in (kept.bending, kept.axial, kept.K, kept.M, kept.shear_g):
+                if array is not None:
+                    array.flags.writeable = False
             if len(_MEMBER_ELEMENTS) >= _MEMBER_ELEMENTS_KEPT:
                 _MEMBER_ELEMENTS.clear()
             _MEMBER_ELEMENTS[key] = kept
@@ -828,13 +838,28 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     local_m[np.ix_(range(n), axial, axial)] = el.generic_bar_mass(
         rhoA, L, np.full(n, el.BAR_MASS_BETA["consistent"]))
     p = _member_bending(model, member, L[0])
+    kGA = member_shear_rigidity(model, member)
+    g = None
+    if kGA is not None:   # eq. 18's shear softening of each element, its own EI (a crack's)
+        g = el.shear_parameter(p[:, 0] / 12.0, kGA, L)
+        soft = el.timoshenko_correction({"k_ww": p[:, 0], "k_tt": p[:, 2]}, g)
+        p = np.stack([soft["k_ww"], soft["k_wt"], soft["k_tt"]], axis=1)
     P = np.stack([np.stack([p[:, 0], p[:, 1]], -1), np.stack([p[:, 1], p[:, 2]], -1)], -2)
     H = el.BEAM_DEFORMATION_H
     scaling = el.beam_dof_scaling(L)                     # (n, 4)
     scaled = np.einsum("ji,ejk,kl->eil", H, P, H) / L[:, None, None] ** 3
     local_k[np.ix_(range(n), bend, bend)] = scaled * scaling[:, :, None] * scaling[:, None, :]
+    if kGA is None:
+        mass_params = el.CONSISTENT_BEAM_MASS
+    else:   # eq. 18's translational mass and the rotary inertia ρI, g of the member's EI
+        ei = model.stiffness_factor * member.E * member.inertia
+        _, mass_params = el.timoshenko_parameters(ei, kGA, L[0])
     mass = (rhoA * L)[:, None, None] * el.symmetric_beam_mass(
-        **{key: np.full(n, v) for key, v in el.CONSISTENT_BEAM_MASS.items()})
+        **{key: np.full(n, v) for key, v in mass_params.items()})
+    if kGA is not None:
+        mass = mass + el.timoshenko_rotary_inertia(
+            np.full(n, member.rho * member.inertia), L,
+            el.shear_parameter(np.full(n, ei), kGA, L))
     local_m[np.ix_(range(n), bend, bend)] = mass * scaling[:, :, None] * scaling[:, None, :]
     tension = _member_tension(model, member)
     if tension:   # geometric stiffness T ∫ N'ᵀN' dx of the transverse motion
@@ -849,7 +874,25 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
         local_m[j] += _zone_mass(zones, rhoA[j], start, L[0], x, w)
     T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
     Tt = np.swapaxes(T, 1, 2)
-    return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension, foundation)
+    return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension, foundation, g)
+
+
+def shear_rigidity(model: FrameModel) -> float | None:
+    """The ``shear`` effect's κGA (the first member's) [N], None without one."""
+    return next((float(e.parameters["shear_rigidity"]) for e in model.effects
+                 if e.name == "shear" and "shear_rigidity" in e.parameters), None)
+
+
+def member_shear_rigidity(model: FrameModel, member: Member) -> float | None:
+    """``member``'s κGA under a ``shear`` effect: its shear rigidity times the member's GA
+    over the first member's (G = E / (2 (1 + ν)): κ the same for every member), None
+    without one."""
+    value = shear_rigidity(model)
+    if value is None:
+        return None
+    first = model.members[0]
+    return value * (member.E / (1.0 + member.nu) * member.area) \
+        / (first.E / (1.0 + first.nu) * first.area)
 
 
 def _member_tension(model: FrameModel, member: Member) -> float:
@@ -911,7 +954,11 @@ def _attached(model: FrameModel, mesh: FrameMesh, name: str):
     found = [e for e in model.raw_effects if e["effect"] == name]
     if not found:
         return None
-    from .frame_data import build_observation as observation
+    from .frame_data import build_observation, shear_reading
+
+    def observation(model, mesh, places):   # as a sensor reads them, Timoshenko or not
+        C = build_observation(model, mesh, places)
+        return C if shear_rigidity(model) is None else C + shear_reading(model, mesh, places)
 
     if name == "point_mass":
         places = [{"member": e["member"], "position": e["position"], "direction": d}
@@ -988,6 +1035,10 @@ class FrameDiscretisation:
                                                        * model.member_length(m) ** 4)
                                     for m in model.members)
         self._matrices = None
+        if shear_rigidity(model) is not None:
+            #: Timoshenko members: each element's g (a fit then differentiates the sensors'
+            #: reading too: it interpolates with the shear strains)
+            self.shear_g = np.concatenate([m.shear_g for m in member_elements(model)])
 
     def global_matrices(self, params=None):
         """(K, M) over all DOFs, supports not applied (``params`` must be None: a frame's

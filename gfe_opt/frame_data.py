@@ -40,6 +40,7 @@ from .frame import (
     frame_mesh,
     frame_modes,
     rotations,
+    shear_rigidity,
 )
 from .measured import ModeCounts, time_and_label
 
@@ -278,7 +279,42 @@ def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
             _OBSERVATIONS.pop(next(iter(_OBSERVATIONS)))   # the least recently used
     if OBSERVATIONS_KEPT > 0:
         _OBSERVATIONS[key] = C
-    return C.copy()
+    return C.copy() if shear_rigidity(model) is None else C + shear_reading(model, mesh, sensors)
+
+
+def shear_reading(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
+    r"""What Timoshenko members (a ``shear`` effect) add to the reading of sensors between
+    their nodes (:func:`build_observation` is the Euler–Bernoulli one): the deflection is
+    cubic Hermite in w with nodal slopes θ + γ, θ the section's rotation, as a beam's
+    (:func:`gfe_opt.measured._shear_sensor_matrix`): γ at a node is the cubic interpolation
+    along the member of its elements' constant shear strains
+    :math:`γ_e = \frac{g}{1+g}\left(\frac{v_b - v_a}{L} - \frac{θ_a + θ_b}{2}\right)`."""
+    from .frame import member_elements
+    from .measured import _element_to_node
+
+    members = member_elements(model)
+    index = {m.id: k for k, m in enumerate(model.members)}
+    rows, cols, vals = [], [], []
+    for i, s in enumerate(sensors):
+        if "node" in s:
+            continue   # a joint: read at the node, nothing interpolated
+        k = index[s["member"]]
+        member, g = model.members[k], members[k].shear_g
+        L = model.member_length(member) / member.elements
+        j = min(int(s["position"] // L), member.elements - 1)
+        H = el.hermite(s["position"] / L - j)
+        first = int(np.flatnonzero(mesh.element_member == k)[0])
+        c, sn = mesh.cosines[first]
+        a = math.radians(_angle(s["direction"], "", ""))
+        across = math.cos(a) * -sn + math.sin(a) * c      # the direction's transverse part
+        nodes = _element_to_node(member.elements)
+        weights = (L * H[1] * nodes[j] + L * H[3] * nodes[j + 1]).tocoo()
+        strain = np.array([sn / L, -c / L, -0.5, -sn / L, c / L, -0.5])
+        for e, w in zip(weights.col, weights.data):
+            rows += [i] * 6
+            cols += mesh.element_dofs[first + e].tolist()
+            vals += (w * g[e] / (1.0 + g[e]) * across * strain).tolist()
+    return sp.csr_matrix((vals, (rows, cols)), shape=(len(sensors), mesh.n_dof))
 
 
 def build_observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:

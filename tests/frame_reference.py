@@ -19,6 +19,13 @@ a member's prestrain (a turnbuckle) sets up in a frame, by the exact static stif
 A member may lie on a Winkler foundation k_f [N/m²] (an eighth entry; the seventh, its axial
 force, then given, 0 for none): EI w⁗ − T w″ + (k_f − ρAω²) w = 0, solved by exp(r x) over
 the four (complex) roots r, below the foundation's own frequency √(k_f/ρA) as above it.
+
+A member may be a Timoshenko beam (a ninth entry: its shear rigidity κGA, N; the seventh and
+eighth then 0): κGA (w″ − ψ′) + ρAω² w = 0 and EI ψ″ + κGA (w′ − ψ) + ρIω² ψ = 0, ψ the
+section's rotation (the joint's θ), with its rotary inertia ρI.  w = e^{rx}, ψ = a e^{rx}
+with a = (κGA r² + ρAω²) / (κGA r) and r² the roots of κGA EI s² + ω² (κGA ρI + ρA EI) s
++ ρAω² (ρIω² − κGA) = 0; the end forces F₁ = −κGA (w′ − ψ)(0), M₁ = −EI ψ′(0),
+F₂ = κGA (w′ − ψ)(L), M₂ = EI ψ′(L) (Euler–Bernoulli's as κGA → ∞).
 """
 
 from __future__ import annotations
@@ -42,9 +49,10 @@ def _wavenumbers(E, rho, A, inertia, omega, tension=0.0):
 
 
 def member_dynamic_stiffness(E, rho, A, inertia, L, omega, tension=0.0,
-                             foundation=0.0) -> np.ndarray:
+                             foundation=0.0, shear=None) -> np.ndarray:
     """(6, 6) dynamic stiffness in the member's axes, DOFs u₁, v₁, θ₁, u₂, v₂, θ₂ (with a
-    constant axial force ``tension``, N, and a Winkler ``foundation``, N/m²)."""
+    constant axial force ``tension``, N, and a Winkler ``foundation``, N/m²; ``shear``: a
+    Timoshenko member's κGA, N)."""
     D = np.zeros((6, 6))
     k = omega * math.sqrt(rho / E)
     if k * L < 1e-8:
@@ -54,6 +62,13 @@ def member_dynamic_stiffness(E, rho, A, inertia, L, omega, tension=0.0,
                                                          [-1.0, math.cos(k * L)]])
     D[np.ix_([0, 3], [0, 3])] = axial
     EI = E * inertia
+    if shear is not None:
+        assert tension == 0.0 and foundation == 0.0, "a Timoshenko member: no T, no k_f"
+        B, F, _ = _timoshenko(E, rho, A, inertia, omega, shear, L)
+        bending = F @ np.linalg.inv(B)
+        assert np.max(np.abs(bending.imag)) <= 1e-8 * np.max(np.abs(bending.real))
+        D[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = bending.real
+        return D
     basis = _transverse(E, rho, A, inertia, omega, tension, foundation)
 
     def derivs(x):
@@ -86,6 +101,28 @@ def _transverse(E, rho, A, inertia, omega, tension=0.0, foundation=0.0):
     squares = [(tension + disc) / (2 * EI), (tension - disc) / (2 * EI)]
     roots = np.array([sign * np.sqrt(r2) for r2 in squares for sign in (1.0, -1.0)])
     return lambda t, order: roots**order * np.exp(roots * t)
+
+
+def _timoshenko(E, rho, A, inertia, omega, shear, L):
+    """A Timoshenko member at ω: (B, F, w) with B the end values [w(0), ψ(0), w(L), ψ(L)]
+    and F the end forces [F₁, M₁, F₂, M₂] of the four solutions e^{rx} (columns), and
+    ``w(x)`` their deflections at x."""
+    EI, rA, rI = E * inertia, rho * A, rho * inertia
+    a2, b2 = shear * EI, omega**2 * (shear * rI + rA * EI)
+    c2 = rA * omega**2 * (rI * omega**2 - shear)
+    disc = np.sqrt(complex(b2**2 - 4.0 * a2 * c2))
+    squares = [(-b2 + disc) / (2 * a2), (-b2 - disc) / (2 * a2)]
+    r = np.array([sign * np.sqrt(s2) for s2 in squares for sign in (1.0, -1.0)])
+    a = (shear * r**2 + rA * omega**2) / (shear * r)
+
+    def w(x):
+        return np.exp(r * x)
+
+    e0, e1 = w(0.0), w(L)
+    B = np.array([e0, a * e0, e1, a * e1])
+    F = np.array([-shear * (r - a) * e0, -EI * a * r * e0, shear * (r - a) * e1,
+                  EI * a * r * e1])
+    return B, F, w
 
 
 class ExactFrame:
@@ -139,7 +176,7 @@ class ExactFrame:
             T[:3, :3], T[3:, 3:] = R, R
             dofs = self._member_dofs(k)
             Dm = member_dynamic_stiffness(E, rho, A, inertia, L, omega, _tension(m),
-                                          _foundation(m))
+                                          _foundation(m), _shear(m))
             D[np.ix_(dofs, dofs)] += T.T @ Dm @ T
         for i, j, k in self.springs:
             D[np.ix_([i, j], [i, j])] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
@@ -215,11 +252,17 @@ class ExactFrame:
             x = s["position"]
             ka = w * math.sqrt(rho / E)
             axial = (u1 * math.sin(ka * (L - x)) + u2 * math.sin(ka * x)) / math.sin(ka * L)
-            basis = _transverse(E, rho, A, inertia, w, _tension(self.members[k]),
-                                _foundation(self.members[k]))
-            B = np.array([basis(0, 0), basis(0, 1), basis(L, 0), basis(L, 1)])
-            coef = np.linalg.solve(B, [v1, g[2], v2, g[5]])
-            transverse = float(np.real(basis(x, 0) @ coef))
+            if _shear(self.members[k]) is not None:
+                B, _, deflection = _timoshenko(E, rho, A, inertia, w, _shear(self.members[k]),
+                                               L)
+                coef = np.linalg.solve(B, np.array([v1, g[2], v2, g[5]], dtype=complex))
+                transverse = float(np.real(deflection(x) @ coef))
+            else:
+                basis = _transverse(E, rho, A, inertia, w, _tension(self.members[k]),
+                                    _foundation(self.members[k]))
+                B = np.array([basis(0, 0), basis(0, 1), basis(L, 0), basis(L, 1)])
+                coef = np.linalg.solve(B, [v1, g[2], v2, g[5]])
+                transverse = float(np.real(basis(x, 0) @ coef))
             out.append(direction @ (R.T @ np.array([axial, transverse])))
         return np.array(out)
 
@@ -244,6 +287,11 @@ def _tension(member) -> float:
 def _foundation(member) -> float:
     """A member tuple's foundation modulus k_f (its eighth entry; 0 without one)."""
     return float(member[7]) if len(member) > 7 else 0.0
+
+
+def _shear(member):
+    """A member tuple's shear rigidity κGA (its ninth entry; None: Euler–Bernoulli)."""
+    return float(member[8]) if len(member) > 8 and member[8] is not None else None
 
 
 def member_static_stiffness(E, A, inertia, L) -> np.ndarray:
