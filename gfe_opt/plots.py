@@ -499,7 +499,8 @@ FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "support_spring": ("D", "tab:brown"), "support_translation": ("D", "tab:brown"),
                "point_mass": ("s", "tab:purple"), "point_spring": ("^", "tab:green"),
                "axial_stiffness": (None, "tab:blue"),
-               "axial_load": (None, "tab:cyan"), "foundation": (None, "tab:olive")}
+               "axial_load": (None, "tab:cyan"), "foundation": (None, "tab:olive"),
+               "shear": ("*", "tab:pink")}
 
 
 def frame_findings(members, marks, failing, title):

@@ -40,7 +40,11 @@ drawn from the seed:
   moves that mode by 2.5 % to one that holds it at 2.4 times its frequency), the exact
   member solving EI w⁗ + (k_f − ρAω²) w = 0; the answer a ``foundation`` under that
   member, its size k_f.  The classes after the tenth draw their cases from seeds of their
-  own (seed + 1000 + 10 i + their index past the tenth), so the first ten keep theirs.
+  own (seed + 1000 + 10 i + their index past the tenth), so the first ten keep theirs;
+* ``deep``: the portal with every member 0.02 to 0.08 m deep (log-uniform; ℓ/h 3.75 to 20;
+  the model is that deep portal, Euler–Bernoulli) measured from the exact frame of
+  Timoshenko members (κGA = 5/6 G A, rotary inertia ρI; ``tests/frame_reference.py``); the
+  answer ``shear``, its size the first member's κGA.
 
 Noise 1 to 2.5 times 0.3 % shape / 0.05 % frequency, stated (its true level) in half the
 cases.  The loop is the beam campaign's (``bench_diagnosis.follow``): ``diagnose``; while
@@ -92,10 +96,11 @@ from gfe_opt.frame import frame_modes  # noqa: E402
 from gfe_opt.model import Effect  # noqa: E402
 from gfe_opt.problems import portal_frame  # noqa: E402
 from tests.frame_reference import ExactFrame, self_stress, zone_frame  # noqa: E402
+from tests.test_frame import deep_portal  # noqa: E402
 from tests.test_frame_diagnosis import NOISE, _braced_portal, _exact, _guess, _measured, _sensors  # noqa: E402
 
 CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material", "zone", "tension",
-           "lean", "ground")
+           "lean", "ground", "deep")
 POSITION_TOLERANCE = 0.02
 DETECTABLE = 2.0     # first chi2/n at the stated noise below which a change is noise
 
@@ -192,6 +197,9 @@ def make_case(seed: int, group: str) -> dict:
                            ids)
         bracket = [Effect("foundation", {"member": member.id, "stiffness": kf})]
         answers = [{"name": "foundation", "member": member.id, "size": kf}]
+    elif group == "deep":
+        model, exact, bracket = deep_portal(_log_uniform(rng, 0.02, 0.08))
+        answers = [{"name": "shear", "size": bracket[0].parameters["shear_rigidity"]}]
     elif group == "tension":
         model = _braced_portal()
         members = [(m.start, m.end, m.E, m.rho, m.area, m.inertia) for m in model.members]
@@ -279,7 +287,7 @@ def _matches(model, effect: Effect, answer: dict) -> bool:
         ends = {member.start: 0.0, member.end: L}
         return answer["node"] in ends and abs(p["position"] - ends[answer["node"]]) \
             <= POSITION_TOLERANCE * L
-    return answer["name"] == "material"   # the whole frame: no place
+    return answer["name"] in ("material", "shear")   # the whole frame: no place
 
 
 def _size(model, effect: Effect):
@@ -287,7 +295,8 @@ def _size(model, effect: Effect):
     if effect.name == "section_loss":   # the added bending compliance (rad / (N m))
         m = model.member(p["member"])
         return p["length"] * (1 / p["stiffness_ratio"] - 1) / (m.E * m.inertia)
-    return p.get("stiffness", p.get("mass", p.get("E", p.get("tension"))))
+    return p.get("stiffness", p.get("mass", p.get("E", p.get("tension",
+                                                             p.get("shear_rigidity")))))
 
 
 def run_case(case: dict) -> dict:

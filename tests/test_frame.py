@@ -1006,10 +1006,10 @@ def test_cli_update_on_a_frame(tmp_path):
                           "joint_spring:node=A,member=beam"], capture_output=True, text=True)
     assert bad.returncode == 2 and "does not end at node 'A'" in bad.stderr
     assert len(bad.stderr.strip().splitlines()) == 1
-    shear = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
-                            "shear"], capture_output=True, text=True)
-    assert shear.returncode == 2 and "not fitted on frames yet" in shear.stderr
-    assert len(shear.stderr.strip().splitlines()) == 1
+    profile = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
+                              "stiffness_profile"], capture_output=True, text=True)
+    assert profile.returncode == 2 and "not fitted on frames yet" in profile.stderr
+    assert len(profile.stderr.strip().splitlines()) == 1
     twice = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data] + [
         "--add", "joint_spring:node=B,member=beam"] * 2, capture_output=True, text=True)
     assert twice.returncode == 2 and "repeats" in twice.stderr
