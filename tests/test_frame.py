@@ -392,13 +392,17 @@ def test_a_foundation_under_a_member_converges_to_the_exact_frame_on_it(member, 
     assert min(truth) < math.sqrt(kf / (m.rho * m.area)) / (2 * math.pi)
 
 
-def deep_portal(depth=0.08):
-    """The portal with every member ``depth`` deep (ℓ/h 3.75 to 5 at 0.08 m) and the
-    exact frame of Timoshenko members of κGA = 5/6 G A (a rectangle), rotary inertia ρI."""
+def deep_portal(depth=0.08, beam_depth=None):
+    """The portal with every member ``depth`` deep (ℓ/h 3.75 to 5 at 0.08 m; the beam
+    ``beam_depth`` if given) and the exact frame of Timoshenko members of κGA = 5/6 G A (a
+    rectangle), rotary inertia ρI."""
     base = portal_frame()
-    model = replace(base, members=tuple(replace(m, area=0.05 * depth,
-                                                inertia=0.05 * depth**3 / 12, depth=depth)
-                                        for m in base.members))
+
+    def deep(m):
+        h = beam_depth if m.id == "beam" and beam_depth is not None else depth
+        return replace(m, area=0.05 * h, inertia=0.05 * h**3 / 12, depth=h)
+
+    model = replace(base, members=tuple(deep(m) for m in base.members))
 
     def kga(m):
         return 5 / 6 * m.E / (2 * (1 + m.nu)) * m.area
