@@ -665,19 +665,31 @@ def test_a_deep_portal_lacks_shear_not_a_softer_steel(beam_depth):
     assert again.verdict == "consistent", again.notes
 
 
-@pytest.mark.slow   # 80 s each: the loop, two diagnoses and an update
-@pytest.mark.parametrize("case", ["mass and joint", "support and joint"])
+@pytest.mark.slow   # 80 to 100 s each: the loop, two diagnoses and an update
+@pytest.mark.parametrize("case", ["mass and joint", "support and joint", "shear and joint"])
 def test_two_different_changes_are_found_together_and_then_the_portal_agrees(case):
     """Two unrelated changes at once, exact (no gfe-opt element), outside the frame
     campaign's classes (one change each): 0.15 kg at joint C with the beam's end at B
     loose (3000 N m/rad), or base A turning against 800 N m/rad with the beam's end at C
-    loose (4000).  The loop names both at their places within 5 % and ends consistent."""
+    loose (4000), or every member 0.04 m deep (ℓ/h 7.5 to 10, Timoshenko members of
+    κGA 5/6 G A) with the beam's end at B loose (half its 4EI/ℓ).  The loop names both at
+    their places within 5 % and ends consistent."""
     from gfe_opt.diagnosis import follow
+
+    from .test_frame import deep_portal
 
     model = portal_frame()
     members = [(m.start, m.end, m.E, m.rho, m.area, m.inertia) for m in model.members]
     beam, ids = [m.id for m in model.members].index("beam"), [m.id for m in model.members]
-    if case == "mass and joint":
+    if case == "shear and joint":
+        model, deep, truth = deep_portal(0.04)
+        b = model.member("beam")
+        k = 2.0 * b.E * b.inertia / model.member_length(b)
+        exact = ExactFrame(deep.nodes, deep.members, dict(model.supports), [("B", beam, k)],
+                           ids)
+        truth = truth + [Effect("joint_spring", {"node": "B", "member": "beam",
+                                                 "stiffness": k})]
+    elif case == "mass and joint":
         exact = ExactFrame(model.nodes, members, dict(model.supports), [("B", beam, 3000.0)],
                            ids, (), [("C", 0.15)])
         truth = [Effect("joint_spring", {"node": "B", "member": "beam", "stiffness": 3000.0}),
@@ -695,7 +707,7 @@ def test_two_different_changes_are_found_together_and_then_the_portal_agrees(cas
         e = next(e for e in out.model.effects if e.name == t.name)
         if "node" in t.parameters:
             assert e.parameters["node"] == t.parameters["node"]
-        else:   # the mass at joint C: the beam's end (or the right column's top)
-            assert e.parameters["member"] in ("beam", "right-column")
-        size = next(k for k in ("stiffness", "mass") if k in t.parameters)
+        elif "member" in t.parameters:   # the mass at joint C: the beam's end (or the
+            assert e.parameters["member"] in ("beam", "right-column")   # right column's top)
+        size = next(k for k in ("stiffness", "mass", "shear_rigidity") if k in t.parameters)
         assert e.parameters[size] == pytest.approx(t.parameters[size], rel=0.05)
