@@ -625,7 +625,9 @@ def _mark(model: FrameModel, name: str, params: dict):
         line = np.array([p for m in model.members
                          for p in (model.nodes[m.start], model.nodes[m.end], (np.nan, np.nan))],
                         dtype=float)   # NaN: one stroke a member
-        label = f"{name} of every member: {values}"
+        label = f"{name} of every member: {values}" + (
+            f" (κGA of {model.members[0].id}; the others' by their GA)"
+            if name == "shear" else "")
     return name, tuple(point), label, line
 
 
