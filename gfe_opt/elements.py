@@ -266,14 +266,23 @@ def timoshenko_parameters(EI, shear_rigidity, L):
 
 
 def timoshenko_correction(bending, g):
-    """eq. 18 applied to bending parameters: k_ww / (1 + g), k_tt (4 + g) / (4 (1 + g)).
+    """Each element's shear compliance added to its bending flexibility: k_ww / (1 + g),
+    k_wθ / (1 + g), k_θθ − g / (1 + g) · k_wθ² / k_ww, with g = k_ww / (κGA L²) (the
+    element's own: 12 EI / (κGA L²) for a uniform one).
 
-    For Euler–Bernoulli ``bending`` (12EI, 6EI, 4EI) this is eq. 18 exactly; for a varying
-    EI it is the same shear softening per element.  ``k_wt = k_ww / 2`` (symmetric element).
+    The generic parameters P = [[k_ww, k_wθ], [k_wθ, k_θθ]] (eq. 11) are L³ times the
+    stiffness of the relative deformations d = H u, a relative deflection d₁ and a relative
+    rotation d₂, whose flexibility is L³ P⁻¹; a shear force, constant along the element,
+    adds V L / κGA to d₁ alone, so P' = (P⁻¹ + diag(1/(κGA L²), 0))⁻¹, the closed form
+    above.  For an Euler–Bernoulli element (12EI, 6EI, 4EI) it is eq. 18 (k_θθ (4 + g) /
+    (4 (1 + g)), k_wθ = k_ww / 2); an element whose EI varies (beside a crack) keeps its own
+    k_wθ, which eq. 18 applied as if the element were symmetric took as k_ww / 2 (25 % off
+    beside a crack of a/d 0.5, for any κGA however large).
     """
-    k_ww = bending["k_ww"] / (1.0 + g)
-    return {"k_ww": k_ww, "k_wt": k_ww / 2.0,
-            "k_tt": bending["k_tt"] * (4.0 + g) / (4.0 * (1.0 + g))}
+    k_ww, k_wt, k_tt = (np.asarray(bending[k], dtype=float) for k in ("k_ww", "k_wt", "k_tt"))
+    soft = 1.0 / (1.0 + np.asarray(g, dtype=float))
+    return {"k_ww": k_ww * soft, "k_wt": k_wt * soft,
+            "k_tt": k_tt - (1.0 - soft) * k_wt**2 / k_ww}
 
 
 def timoshenko_rotary_inertia(rho_I, L, g=0.0):

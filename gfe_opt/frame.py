@@ -842,7 +842,7 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     g = None
     if kGA is not None:   # eq. 18's shear softening of each element, its own EI (a crack's)
         g = el.shear_parameter(p[:, 0] / 12.0, kGA, L)
-        soft = el.timoshenko_correction({"k_ww": p[:, 0], "k_tt": p[:, 2]}, g)
+        soft = el.timoshenko_correction({"k_ww": p[:, 0], "k_wt": p[:, 1], "k_tt": p[:, 2]}, g)
         p = np.stack([soft["k_ww"], soft["k_wt"], soft["k_tt"]], axis=1)
     P = np.stack([np.stack([p[:, 0], p[:, 1]], -1), np.stack([p[:, 1], p[:, 2]], -1)], -2)
     H = el.BEAM_DEFORMATION_H
