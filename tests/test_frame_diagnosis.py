@@ -73,7 +73,8 @@ def _diagnose(model, measured, **noise):
     return d
 
 
-@pytest.mark.parametrize("seed", [11, 12])
+# the second seed in the slow studies: the frame campaign's `none` class runs 8 portals more
+@pytest.mark.parametrize("seed", [11, pytest.param(12, marks=pytest.mark.slow)])
 def test_no_false_alarm_on_a_portal_that_is_as_modelled(seed):
     model = portal_frame()
     measured = _measured(model, _exact(model), _guess(model, []), _sensors(model), seed)
@@ -608,6 +609,7 @@ def test_a_mass_at_a_corner_of_the_symmetric_portal_names_the_corner_it_cannot_t
     assert at_c.model.effects[0].parameters["mass"] == pytest.approx(mass, rel=0.1)
 
 
+@pytest.mark.slow   # 6 s; the frame campaign's `ground` class (a foundation under any member)
 def test_a_beam_resting_on_a_foundation_is_a_foundation_under_that_beam():
     """The portal's beam on a Winkler foundation of half its EI (π/ℓ)⁴ (the exact frame,
     complex wavenumbers below the foundation's own frequency): found under the beam within
@@ -638,7 +640,8 @@ def test_a_beam_resting_on_a_foundation_is_a_foundation_under_that_beam():
         found["stiffness"], rel=1e-4)
 
 
-@pytest.mark.parametrize("beam_depth", [None, 0.035])
+# every member alike in the slow studies (the frame campaign's `deep` class runs 8 more)
+@pytest.mark.parametrize("beam_depth", [pytest.param(None, marks=pytest.mark.slow), 0.035])
 def test_a_deep_portal_lacks_shear_not_a_softer_steel(beam_depth):
     """Columns 0.06 m deep (ℓ/h 5) and the beam as deep (6.7) or 0.035 m (11.4: its
     section then another, its κGA another share of the first member's), measured from the
