@@ -954,11 +954,10 @@ def _attached(model: FrameModel, mesh: FrameMesh, name: str):
     found = [e for e in model.raw_effects if e["effect"] == name]
     if not found:
         return None
-    from .frame_data import build_observation, shear_reading
+    from .frame_data import build_observation, with_shear
 
     def observation(model, mesh, places):   # as a sensor reads them, Timoshenko or not
-        C = build_observation(model, mesh, places)
-        return C if shear_rigidity(model) is None else C + shear_reading(model, mesh, places)
+        return with_shear(model, mesh, places, build_observation(model, mesh, places))
 
     if name == "point_mass":
         places = [{"member": e["member"], "position": e["position"], "direction": d}

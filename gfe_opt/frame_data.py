@@ -279,6 +279,12 @@ def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
             _OBSERVATIONS.pop(next(iter(_OBSERVATIONS)))   # the least recently used
     if OBSERVATIONS_KEPT > 0:
         _OBSERVATIONS[key] = C
+    return with_shear(model, mesh, sensors, C)
+
+
+def with_shear(model: FrameModel, mesh: FrameMesh, sensors, C) -> sp.csr_matrix:
+    """``C`` (:func:`build_observation`'s reading of ``sensors``) as Timoshenko members read
+    them: plus :func:`shear_reading` under a ``shear`` effect; a copy either way."""
     return C.copy() if shear_rigidity(model) is None else C + shear_reading(model, mesh, sensors)
 
 
