@@ -129,12 +129,22 @@ class Discretisation:
 
     def global_matrices(self, params=None) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """Global (K, M) over all DOFs, boundary conditions not applied."""
-        K = self.assemble_elements(self.stiffness_elements(params) + self.extra_stiffness)
+        K = self._with_nodal(self.assemble_elements(self.stiffness_elements(params)
+                                                    + self.extra_stiffness))
+        M = self.assemble_elements(self.mass)
+        return K.tocsr(), M.tocsr()
+
+    def _with_nodal(self, K):
+        """``K`` plus the nodal springs (end springs)."""
         if self.nodal_stiffness:
             dof, val = zip(*self.nodal_stiffness)
             K = K + sp.csr_matrix((val, (dof, dof)), shape=K.shape)
-        M = self.assemble_elements(self.mass)
-        return K.tocsr(), M.tocsr()
+        return K
+
+    def fixed_stiffness(self) -> sp.csr_matrix:
+        """The part of K the generic parameters do not carry (geometric, foundation, point
+        and end springs), all DOFs."""
+        return self._with_nodal(self.assemble_elements(self.extra_stiffness))
 
 
 @lru_cache(maxsize=16)

@@ -745,7 +745,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     """Which effect is missing (module docstring).  ``freq_noise`` and ``shape_noise`` are
     relative (None: not given; defaults 0.05 % and 0.3 % are assumed and the data's own
     level is estimated).  ``progress`` is called as ``progress(done, total, name)``.  With
-    ``realise`` (beams) the generic-element update is run and read in words."""
+    ``realise`` the generic-element update is run (a frame's member by member) and read in
+    words."""
     start = time.perf_counter()
     noise = noise_of(freq_noise, shape_noise)
     names = _candidates(model, candidates)
@@ -791,7 +792,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     for i in drops:
         jobs.append(("without", (model, measured, noise, i)))
         labels.append(f"without {model.effects[i].name}")
-    with_generic = realise and model.kind == "beam" and not measured.frequency_only
+    with_generic = realise and not measured.frequency_only
     copies = []
     if with_generic:  # the paper's generic update runs beside the candidates, and so do
         # the updates of the noisy copies of the model's own modes that read it
@@ -945,7 +946,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         from .realisation import describe_profile, explain
         from .realisation import realise as realise_rows
 
-        if generic.ok:
+        if generic.ok and model.kind == "beam":
             nodal = realise_rows(generic.discretisation, _discretise(model))
         found = ranked[0] if ranked and ranked[0].significant else None
         if band is not None and found is not None:
@@ -1032,7 +1033,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                               together if suggested and together is not None else None)
     if measured.frequency_only:
         notes.append(measured.without_shapes_note())
-        if realise and model.kind == "beam":
+        if realise:
             notes.append("the generic-element update needs mode shapes: not run")
     notes += _noise_notes(estimate, verdict, measured)
     not_needed = _not_needed(model, reference, without, sel) if drops else []
@@ -1278,10 +1279,15 @@ def _generic_update(model, measured, noise):
 
 
 def _generic_only(model, measured, noise):
-    """The paper's generic-element update of the measured data (None if it fails)."""
+    """The paper's generic-element update of the measured data (None if it fails; a
+    frame's member by member, :mod:`gfe_opt.frame_generic`)."""
     from .updating import update_generic
 
     try:
+        if model.kind == "frame":
+            from .frame_generic import update_frame_generic
+
+            return update_frame_generic(model, measured, noise=max(noise.shape, 1e-3))
         return update_generic(_discretise(model), measured, noise=max(noise.shape, 1e-3))
     except (GfeSolverError, ValueError, np.linalg.LinAlgError):
         return None

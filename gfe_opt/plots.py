@@ -54,13 +54,44 @@ def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pin
     features beyond it labelled, and, when an effect was found, what the update reads
     from that effect's own modes; below, the structure with the located place and the
     fitted effects (``findings`` as for :func:`structure_sketch`)."""
-    from .realisation import COLLAPSED
-
     fig = _figure(7.0, 4.6 if length is not None else 3.6)
     if length is not None:
         ax, sketch = fig.subplots(2, 1, sharex=True, height_ratios=(3.4, 1.1))
     else:
         ax, sketch = fig.add_subplot(), None
+    _profile_panel(ax, band, label)
+    ax.set_title("Bending stiffness read from the test at each node, over the model's",
+                 fontsize=10)
+    if sketch is not None:
+        structure_sketch(sketch, length, supports, places=places, findings=findings)
+        sketch.set_xlabel("x [m]")
+    else:
+        ax.set_xlabel("x [m]")
+    return fig
+
+
+def frame_profiles(band, label=None):
+    """A frame's generic update (:class:`~gfe_opt.realisation.FrameProfileBand`): each
+    member's k_i / k_i0 along it from its start node, with its ±3σ noise band and, when an
+    effect was found, the same reading of that effect's own modes; one panel a member."""
+    members = band.members
+    ends = {m.id: (m.start, m.end) for m in band.model_members}
+    fig = _figure(7.0, 1.0 + 2.2 * len(members))
+    axes = np.atleast_1d(fig.subplots(len(members), 1))
+    for ax, (member, start, b) in zip(axes, members):
+        _profile_panel(ax, b, label, legend=ax is axes[0])
+        a, e = ends.get(member, (start, "?"))
+        ax.set_title(f"{member}: from node {a} to node {e}", fontsize=9)
+        ax.set_xlabel(f"distance from node {a} [m]", fontsize=8)
+    fig.suptitle("Bending stiffness read from the test at each node of each member, over "
+                 "the model's", fontsize=10)
+    return fig
+
+
+def _profile_panel(ax, band, label, legend=True):
+    """k_i / k_i0 of one :class:`~gfe_opt.realisation.ProfileBand` on ``ax``."""
+    from .realisation import COLLAPSED
+
     x = band.x
     ok = np.isfinite(band.sigma)
     ax.fill_between(x[ok], (1 - 3 * band.sigma)[ok], (1 + 3 * band.sigma)[ok], color="0.87",
@@ -80,15 +111,8 @@ def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pin
     ax.axhline(1.0, color="0.4", lw=0.8)
     ax.margins(y=0.12)
     ax.set_ylabel("$k_i / k_{i,0}$ (1 = as modelled)")
-    ax.set_title("Bending stiffness read from the test at each node, over the model's",
-                 fontsize=10)
-    ax.legend(fontsize=7, loc="lower right")
-    if sketch is not None:
-        structure_sketch(sketch, length, supports, places=places, findings=findings)
-        sketch.set_xlabel("x [m]")
-    else:
-        ax.set_xlabel("x [m]")
-    return fig
+    if legend:
+        ax.legend(fontsize=7, loc="lower right")
 
 
 def disturbance_function(x_nodes, q_identified, x_fine, q_exact, *, label_exact: str):

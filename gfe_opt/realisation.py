@@ -16,7 +16,7 @@ updated matrices hold.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import sympy
@@ -278,14 +278,16 @@ class Feature:
     value: float
     sigma: float
     start: float = 1.0
+    significance: float = 0.0   # in standard deviations (what orders features)
 
-    def describe(self) -> str:
+    def describe(self, ends=("the left end", "the right end")) -> str:
+        """In words; ``ends`` name where x starts and ends (a frame member's nodes)."""
         if self.kind == "uniform":
             return (f"a uniform change of EI: {self.value:.3f} ± {self.sigma:.3f} of the "
                     "model's (a material change)")
         if self.kind == "taper":
-            return (f"EI tapers from {self.start:.3f} of the model's at the left end to "
-                    f"{self.value:.3f} at the right end (± {self.sigma:.3f}): a taper")
+            return (f"EI tapers from {self.start:.3f} of the model's at {ends[0]} to "
+                    f"{self.value:.3f} at {ends[1]} (± {self.sigma:.3f}): a taper")
         word = "loss" if self.kind == "loss" else "rise"
         extent = ("at one node" if self.x_from == self.x_to else
                   f"{self.x_from:.3f} to {self.x_to:.3f} m")
@@ -318,10 +320,24 @@ def _generic_ratio_of(disc, data, noise, n):
     from .updating import update_generic
 
     try:
+        if disc.kind == "frame":
+            from .frame_generic import member_ratios, update_frame_generic
+
+            result = update_frame_generic(disc.model, data, noise=max(noise.shape, 1e-3))
+            return (np.concatenate([r for _, r in member_ratios(result).values()])
+                    if result.ok else None)
         result = update_generic(disc, data, noise=max(noise.shape, 1e-3))
     except (ValueError, np.linalg.LinAlgError):
         return None
     return result.q[:n + 1] / result.q0[:n + 1] if result.ok else None
+
+
+def _profile_size(disc) -> int:
+    """How many nodal values the generic update's profile has: the beam's nodes, or every
+    member's own nodes on a frame (a joint once per member)."""
+    if disc.kind == "frame":
+        return sum(m.elements + 1 for m in disc.model.members)
+    return disc.n_elements + 1
 
 
 def vibrating_modes(disc: Discretisation, n_modes: int):
@@ -338,12 +354,23 @@ def vibrating_modes(disc: Discretisation, n_modes: int):
 def own_modes(disc: Discretisation, measured):
     """The vibrating modes of ``disc`` at the measured sensors, noise-free, as measured data
     (as many as were measured; a 0 Hz "measured" mode would be refused as bad input)."""
-    from .measured import make_measured, observation
+    from .measured import observation
 
     modes = vibrating_modes(disc, measured.n_modes)
     C = observation(disc, measured)
-    return make_measured(measured.x, measured.dof, modes.frequencies_hz, C @ modes.shapes,
-                         measured.source)
+    return _as_measured(measured, modes.frequencies_hz, C @ modes.shapes)
+
+
+def _as_measured(like, frequencies_hz, shapes):
+    """Measured modes at the sensors of ``like`` (a beam's test or a frame's)."""
+    if hasattr(like, "sensors"):   # a frame's: the same sensors, these modes
+        from dataclasses import replace
+
+        return replace(like, frequencies_hz=np.asarray(frequencies_hz, float),
+                       shapes=np.asarray(shapes, float))
+    from .measured import make_measured
+
+    return make_measured(like.x, like.dof, frequencies_hz, shapes, like.source)
 
 
 def profile_band(disc: Discretisation, measured, result, noise, samples: int = BAND_SAMPLES,
@@ -365,11 +392,74 @@ def profile_band(disc: Discretisation, measured, result, noise, samples: int = B
     own = own_modes(disc, measured)
     if draws is None:
         draws = [generic_ratio(disc, c, noise) for c in _copies(own, noise, samples, seed)]
-    null, sigma = draws_summary(draws, n)
+    null, sigma = draws_summary(draws, _profile_size(disc))
+    if disc.kind == "frame":
+        return _frame_band(disc, result, null, sigma, measured.n_modes)
     ratio = result.q[:n + 1] / result.q0[:n + 1] / null
     sigma = np.where(_determined(disc, own), sigma, np.inf)
     trend, features = _features(disc.nodes, ratio, sigma, measured.n_modes)
     return ProfileBand(disc.nodes, ratio, sigma, trend, tuple(features), null)
+
+
+@dataclass(frozen=True)
+class FrameProfileBand:
+    """A frame's generic update read member by member: each member's :class:`ProfileBand`
+    (positions along it from its start node), in member order."""
+
+    members: tuple      # (member id, its start node, ProfileBand)
+    model_members: tuple = ()   # the frame's Members (their end nodes name a taper's ends)
+
+    @property
+    def features(self) -> tuple:
+        """(member, its start node, feature), the most significant first (at most
+        :data:`FRAME_FEATURES`)."""
+        found = [(f.significance, m, start, f)
+                 for m, start, b in self.members for f in b.features]
+        found.sort(key=lambda item: -item[0])
+        return tuple((m, start, f) for _, m, start, f in found[:FRAME_FEATURES])
+
+    @property
+    def unexplained(self) -> tuple:
+        return tuple((m, start, f) for m, start, f in self.features
+                     if f in dict((mm, b) for mm, _, b in self.members)[m].unexplained)
+
+    @property
+    def sigma(self) -> np.ndarray:
+        return np.concatenate([b.sigma for _, _, b in self.members])
+
+    def explained_by(self, reading) -> "FrameProfileBand":
+        """The band with each member's ``explained`` set from a reading (all members'
+        nodal values, in member order), as :func:`explain` does a beam's."""
+        from dataclasses import replace
+
+        out, i = [], 0
+        for m, start, b in self.members:
+            part = reading[i:i + b.x.size] / b.null
+            i += b.x.size
+            rest = [f for f in b.features if not _shows(f, b.x, part, np.isfinite(b.sigma))]
+            out.append((m, start, replace(b, explained=part, unexplained=tuple(rest))))
+        return FrameProfileBand(tuple(out), self.model_members)
+
+
+#: at most this many features of a frame's generic update are read out
+FRAME_FEATURES = 4
+
+
+def _frame_band(disc, result, null, sigma, n_modes) -> FrameProfileBand:
+    """:func:`profile_band` of a frame: each member's k_i / k_i0 against its part of the
+    null profile and the band, its features read along it."""
+    from .frame_generic import member_ratios
+
+    out, i = [], 0
+    model = disc.model
+    for (member, (x, ratio)), m in zip(member_ratios(result).items(), model.members):
+        part = slice(i, i + x.size)
+        i += x.size
+        r = ratio / null[part]
+        trend, features = _features(x, r, sigma[part], n_modes)
+        out.append((member, m.start, ProfileBand(x, r, sigma[part], trend, tuple(features),
+                                                 null[part])))
+    return FrameProfileBand(tuple(out), tuple(model.members))
 
 
 def noisy_copies(truth: Discretisation, measured, noise, samples: int = BAND_SAMPLES,
@@ -384,15 +474,13 @@ def noisy_copies(truth: Discretisation, measured, noise, samples: int = BAND_SAM
 
 
 def _copies(own, noise, samples, seed) -> list:
-    from .measured import make_measured
-
     rng = np.random.default_rng(seed)
     out = []
     for _ in range(samples):
         y = own.shapes + noise.shape * np.max(np.abs(own.shapes), axis=0) \
             * rng.standard_normal(own.shapes.shape)
         f = own.frequencies_hz * (1 + noise.freq * rng.standard_normal(own.n_modes))
-        out.append(make_measured(own.x, own.dof, f, y, own.source))
+        out.append(_as_measured(own, f, y))
     return out
 
 
@@ -402,11 +490,12 @@ def generic_ratio(disc: Discretisation, data, noise):
     return _generic_ratio_of(disc, data, noise, disc.n_elements)
 
 
-def draws_summary(draws, n: int):
-    """The mean and spread of the draws (k_i / k_i0; failed draws left out)."""
+def draws_summary(draws, size: int):
+    """The mean and spread of the draws (k_i / k_i0, ``size`` values each; failed draws
+    left out)."""
     draws = [d for d in draws if d is not None]
     if len(draws) < 3:
-        return np.ones(n + 1), np.full(n + 1, np.inf)
+        return np.ones(size), np.full(size, np.inf)
     centre = np.mean(draws, axis=0)
     sigma = np.std(np.array(draws) / centre, axis=0, ddof=1)
     finite = sigma[np.isfinite(sigma)]
@@ -427,7 +516,9 @@ def explain(band: ProfileBand, disc: Discretisation, fitted: Discretisation, mea
     if draws is None:
         draws = [generic_ratio(disc, c, noise)
                  for c in noisy_copies(fitted, measured, noise, samples, seed)]
-    reading, _ = draws_summary(draws, disc.n_elements)
+    reading, _ = draws_summary(draws, _profile_size(disc))
+    if isinstance(band, FrameProfileBand):
+        return band.explained_by(reading)
     explained = reading / band.null
     rest = [f for f in band.features if not _shows(f, band.x, explained,
                                                    np.isfinite(band.sigma))]
@@ -531,7 +622,7 @@ def _features(x, ratio, sigma, n_modes):
                                             float(ratio[k] / trend[k]),
                                             float(sigma[k] / trend[k]))))
     features.sort(key=lambda item: -item[0])
-    return trend, [f for _, f in features[:3]]
+    return trend, [replace(f, significance=float(score)) for score, f in features[:3]]
 
 
 def describe_profile(band: ProfileBand, effect: str | None = None,
@@ -543,12 +634,24 @@ def describe_profile(band: ProfileBand, effect: str | None = None,
     if not band.features:
         finite = band.sigma[np.isfinite(band.sigma)]
         width = 100 * FEATURE_SIGMAS * float(np.median(finite)) if finite.size else 0.0
-        return [f"no change of the bending stiffness beyond the noise band (±{width:.1f} %)"]
-    if effect is None or band.explained is None:
-        return [f.describe() for f in band.features]
+        where = " of any member" if isinstance(band, FrameProfileBand) else ""
+        return [f"no change of the bending stiffness{where} beyond the noise band "
+                f"(±{width:.1f} %)"]
+    if isinstance(band, FrameProfileBand):
+        ends = {m.id: (m.start, m.end) for m in band.model_members}
+        features = [((m, f), f"{m} (x from {start}): "
+                     f"{f.describe(tuple(f'node {n}' for n in ends[m]))}")
+                    for m, start, f in band.features]
+        unexplained = [(m, f) for m, _, f in band.unexplained]
+        explained = band.members[0][2].explained is not None
+    else:
+        features = [(f, f.describe()) for f in band.features]
+        unexplained, explained = band.unexplained, band.explained is not None
+    if effect is None or not explained:
+        return [text for _, text in features]
     lobe = (f" (not reproduced by the fitted {effect}; with the {effect} the test fits to "
             "the noise, so this is the update's ringing, not a finding)" if explains_test
             else f" (not reproduced by the fitted {effect})")
-    return [f.describe() + (lobe if f in band.unexplained else
-                            f" (the fitted {effect}'s own modes show it too)")
-            for f in band.features]
+    return [text + (lobe if f in unexplained else
+                    f" (the fitted {effect}'s own modes show it too)")
+            for f, text in features]

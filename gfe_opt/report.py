@@ -54,7 +54,7 @@ def diagnosis_figures(diagnosis, model) -> dict:
     the fitted effects, the nodal equation coefficients and (for a crack) the identified
     Q_i against Christides–Barr Q(x)."""
     found = findings(diagnosis, model)
-    if model.kind == "frame":   # no generic update on frames yet: the effects on the frame
+    if model.kind == "frame":   # the effects on the frame; the generic update per member
         from .frame_data import frame_diagnosis_figures
 
         figs = {"candidates.png": plots.candidate_errors(
@@ -62,6 +62,10 @@ def diagnosis_figures(diagnosis, model) -> dict:
             verdict=verdict_title(diagnosis))} if diagnosis.fits else {}
         figs.update(frame_diagnosis_figures(diagnosis, model, verdict_title(diagnosis),
                                             found))
+        if diagnosis.profile_band is not None:
+            best = diagnosis.best
+            figs["stiffness_change.png"] = plots.frame_profiles(
+                diagnosis.profile_band, label=best.name if best else None)
         return figs
     figs = {"candidates.png": plots.candidate_errors(
         diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,

@@ -102,7 +102,7 @@ from . import elements as el
 from .assembly import Discretisation, discretise
 from .correlation import DEFAULT_SHAPE_NOISE, expand_modes
 from .errors import GfeInputError, GfeSolverError
-from .measured import MeasuredModes, sensor_matrix
+from .measured import MeasuredModes, observation, sensor_matrix
 from .model import Model
 from .parameterisation import Parameterisation, parameterisation_for
 
@@ -180,11 +180,7 @@ def stiffness_map(disc: Discretisation, par: Parameterisation) -> StiffnessMap:
     cols = np.tile(dofs, (1, size)).ravel()
     keep = (local[rows] >= 0) & (local[cols] >= 0)
     r, c = local[rows[keep]], local[cols[keep]]
-    K_extra = disc.assemble_elements(disc.extra_stiffness)
-    if disc.nodal_stiffness:
-        dof, val = zip(*disc.nodal_stiffness)
-        K_extra = K_extra + sp.csr_matrix((val, (dof, dof)), shape=K_extra.shape)
-    ke = sp.csc_matrix(K_extra)[free][:, free].tocoo()
+    ke = sp.csc_matrix(disc.fixed_stiffness())[free][:, free].tocoo()
     n = free.size
     pattern = sp.csc_matrix((np.ones(r.size + ke.nnz), (np.concatenate([r, ke.row]),
                                                          np.concatenate([c, ke.col]))),
@@ -439,7 +435,9 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
     (the current updated model).  ``kmap``: the stiffness map of (disc, par) if known."""
     free = disc.free
     K_full, M_full = disc.global_matrices()
-    C_full = sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
+    frame = disc.kind == "frame"
+    C_full = observation(disc, measured) if frame else sensor_matrix(
+        disc.nodes, disc.kind, measured.x, measured.dof, measured.source)
     y = measured.shapes / np.linalg.norm(measured.shapes, axis=0)
     if full_shapes is None:
         if expansion_disc is None:
@@ -455,8 +453,11 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
     C = sp.csr_matrix(C_full)[:, free]
     kmap = stiffness_map(disc, par) if kmap is None else kmap
     d = 1.0 / np.sqrt(M.diagonal())
-    node_share = _node_energy_share(disc, phi_full)  # (n_nodes, m)
-    per_dof = np.repeat(node_share, disc.dofs_per_node, axis=0)[free]
+    if frame:
+        per_dof = disc.dof_energy_share(phi_full)[free]
+    else:
+        node_share = _node_energy_share(disc, phi_full)  # (n_nodes, m)
+        per_dof = np.repeat(node_share, disc.dofs_per_node, axis=0)[free]
     inertia = measured.omega**2 * (M @ phi_full[free])
     flexibility = None
     if weighting == "energy":
@@ -467,14 +468,14 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
     else:
         F = np.linalg.norm(d[:, None] * inertia, axis=0)
         row_weights = np.sqrt(ENERGY_FLOOR + per_dof) * d[:, None] / F
-    k_scale = disc.stiffness_params["k_ww"] / 12.0 if disc.kind == "beam" else \
-        disc.stiffness_params["k"]
+    k_scale = disc.stiffness_params["k"] if disc.kind == "bar" else \
+        disc.stiffness_params["k_ww"] / 12.0
     k0 = float(np.mean(k_scale))
     if q0 is None:
         q0 = par.fit(disc.stiffness_params)
     labels = par.labels
-    scale = np.array([k0 / disc.element_length if lab.startswith("dk/dx") else k0
-                      for lab in labels])
+    scale = disc.parameter_scale(par) if frame else np.array(
+        [k0 / disc.element_length if lab.startswith("dk/dx") else k0 for lab in labels])
     if par.name == "element" and disc.kind == "beam":
         scale = scale * np.repeat([12.0, 6.0, 4.0], par.n_elements)
     e_el = np.abs(disc.element_strain_energy(phi_full)).sum(axis=1)
@@ -511,7 +512,7 @@ def _objective_terms(pb: _Problem, x, phi, data_term: bool):
 
 
 def _feasibility(pb: _Problem, x) -> list:
-    conds = el.BEAM_STIFFNESS_CONDITIONS if pb.disc.kind == "beam" else el.BAR_CONDITIONS[:1]
+    conds = el.BAR_CONDITIONS[:1] if pb.disc.kind == "bar" else el.BEAM_STIFFNESS_CONDITIONS
     params = pb.par.element_parameters(x[:pb.n_q])
     scaled = {k: np.asarray(v) / pb.k0 for k, v in params.items()}
     found = el.feasibility_violations(conds, scaled)

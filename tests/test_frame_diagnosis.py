@@ -56,6 +56,26 @@ def _exact(model, joint_springs=(), ground_springs=()):
                       joint_springs, [m.id for m in model.members], ground_springs)
 
 
+def line_spring_column(model, a, k):
+    """The exact portal whose left column is two members joined ``a`` up from A by a
+    rotational line spring ``k`` [N m/rad] (another crack law than the package's), and the
+    map of a sensor on the model's left column to the exact frame's own."""
+    nodes = {"A": (0.0, 0.0), "K": (0.0, a), **{n: model.nodes[n] for n in ("B", "C", "D")}}
+    props = [(m.E, m.rho, m.area, m.inertia) for m in model.members]
+    members = [("A", "K", *props[0]), ("K", "B", *props[0]), ("B", "C", *props[1]),
+               ("D", "C", *props[2])]
+    exact = ExactFrame(nodes, members, dict(model.supports), [("K", 1, k)],
+                       ["lower", "upper", "beam", "right-column"])
+
+    def where(s):
+        if s.get("member") != "left-column":
+            return s
+        p = s["position"]
+        return {**s, "member": "lower" if p < a else "upper", "position": p if p < a else p - a}
+
+    return exact, where
+
+
 def _guess(model, effects):
     fine = replace(model, members=tuple(replace(m, elements=40) for m in model.members))
     return frame_modes(fine.with_effects(effects, check=False), 6).frequencies_hz
@@ -237,20 +257,8 @@ def test_a_crack_near_a_column_base_is_found_on_that_column_at_its_place():
     crack on the left column within 2 % of its length of the line spring, and after it the
     model agrees."""
     model = portal_frame()
-    a, k = 0.06, 46000.0
-    nodes = {"A": (0.0, 0.0), "K": (0.0, a), **{n: model.nodes[n] for n in ("B", "C", "D")}}
-    props = [(m.E, m.rho, m.area, m.inertia) for m in model.members]
-    members = [("A", "K", *props[0]), ("K", "B", *props[0]), ("B", "C", *props[1]),
-               ("D", "C", *props[2])]
-    exact = ExactFrame(nodes, members, dict(model.supports), [("K", 1, k)],
-                       ["lower", "upper", "beam", "right-column"])
-
-    def where(s):
-        if s.get("member") != "left-column":
-            return s
-        p = s["position"]
-        return {**s, "member": "lower" if p < a else "upper", "position": p if p < a else p - a}
-
+    a = 0.06
+    exact, where = line_spring_column(model, a, 46000.0)
     bracket = [Effect("crack", {"member": "left-column", "position": a, "depth_ratio": 0.5})]
     measured = _measured(model, exact, _guess(model, bracket), _sensors(model), 9, where)
     d = _diagnose(model, measured, **NOISE)
