@@ -74,22 +74,25 @@ def frame_profiles(band, label=None):
     """A frame's generic update (:class:`~gfe_opt.realisation.FrameProfileBand`): each
     member's k_i / k_i0 along it from its start node, with its ±3σ noise band and, when an
     effect was found, the same reading of that effect's own modes; one panel a member."""
-    members = band.members
+    bending = [m for m in band.members if m[3] == "EI"]
+    axial = {m[0]: m for m in band.members if m[3] == "EA"}
     ends = {m.id: (m.start, m.end) for m in band.model_members}
-    fig = _figure(7.0, 1.0 + 2.2 * len(members))
-    axes = np.atleast_1d(fig.subplots(len(members), 1))
-    for ax, (member, start, b) in zip(axes, members):
-        _profile_panel(ax, b, label, legend=ax is axes[0])
+    fig = _figure(9.0, 1.0 + 2.2 * len(bending))
+    axes = np.atleast_2d(fig.subplots(len(bending), 2, squeeze=False))
+    for row, (member, start, b, _) in zip(axes, bending):
         a, e = ends.get(member, (start, "?"))
-        ax.set_title(f"{member}: from node {a} to node {e}", fontsize=9)
-        ax.set_xlabel(f"distance from node {a} [m]", fontsize=8)
-    fig.suptitle("Bending stiffness read from the test at each node of each member, over "
-                 "the model's", fontsize=10)
+        for ax, what, part in ((row[0], "EI", b), (row[1], "EA", axial[member][2])):
+            _profile_panel(ax, part, label, legend=ax is axes[0][0], quantity=what)
+            ax.set_title(f"{member}: {what}, from node {a} to node {e}", fontsize=9)
+            ax.set_xlabel(f"distance from node {a} [m]", fontsize=8)
+    fig.suptitle("Bending (EI) and axial (EA) stiffness read from the test at each node of "
+                 "each member, over the model's", fontsize=10)
     return fig
 
 
-def _profile_panel(ax, band, label, legend=True):
-    """k_i / k_i0 of one :class:`~gfe_opt.realisation.ProfileBand` on ``ax``."""
+def _profile_panel(ax, band, label, legend=True, quantity="EI"):
+    """k_i / k_i0 (``quantity`` "EA": EA_i / EA_i0) of one
+    :class:`~gfe_opt.realisation.ProfileBand` on ``ax``."""
     from .realisation import COLLAPSED
 
     x = band.x
@@ -110,7 +113,8 @@ def _profile_panel(ax, band, label, legend=True):
                     color="0.45" if grey else "black")
     ax.axhline(1.0, color="0.4", lw=0.8)
     ax.margins(y=0.12)
-    ax.set_ylabel("$k_i / k_{i,0}$ (1 = as modelled)")
+    ax.set_ylabel("$k_i / k_{i,0}$ (1 = as modelled)" if quantity == "EI" else
+                  "$EA_i / EA_{i,0}$ (1 = as modelled)")
     if legend:
         ax.legend(fontsize=7, loc="lower right")
 

@@ -478,9 +478,12 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
         [k0 / disc.element_length if lab.startswith("dk/dx") else k0 for lab in labels])
     if par.name == "element" and disc.kind == "beam":
         scale = scale * np.repeat([12.0, 6.0, 4.0], par.n_elements)
-    e_el = np.abs(disc.element_strain_energy(phi_full)).sum(axis=1)
-    e_el = e_el / max(e_el.mean(), 1e-300)
-    share = np.abs(par.matrix).T @ np.tile(e_el, len(par.keys))
+    if frame:   # bending and axial parameters each by their own energy
+        share = disc.parameter_energy(par, phi_full)
+    else:
+        e_el = np.abs(disc.element_strain_energy(phi_full)).sum(axis=1)
+        e_el = e_el / max(e_el.mean(), 1e-300)
+        share = np.abs(par.matrix).T @ np.tile(e_el, len(par.keys))
     share = share / max(share.mean(), 1e-300)
     param_weights = 1.0 / (ENERGY_FLOOR + share)
     pb = _Problem(disc=disc, par=par, kmap=kmap, M=M, C=C, omega=measured.omega, y=y,
@@ -516,6 +519,8 @@ def _feasibility(pb: _Problem, x) -> list:
     params = pb.par.element_parameters(x[:pb.n_q])
     scaled = {k: np.asarray(v) / pb.k0 for k, v in params.items()}
     found = el.feasibility_violations(conds, scaled)
+    if pb.disc.kind == "frame":   # a frame's members: the bar's k > 0 too
+        found += el.feasibility_violations(el.BAR_CONDITIONS[:1], {"k": scaled["k"]})
     if pb.mmap is not None:
         m = x[pb.n_q:]
         conds = el.BAR_CONDITIONS[1:] if pb.disc.kind == "bar" else \
@@ -675,8 +680,10 @@ def _constraints(pb: _Problem, x):
     if pb.disc.kind == "bar":
         g = [p]
     else:
-        ww, wt, tt = p[:n], p[n:2 * n], p[2 * n:]
+        ww, wt, tt = p[:n], p[n:2 * n], p[2 * n:3 * n]
         g = [ww, tt, ww * tt - wt**2]
+        if pb.disc.kind == "frame":   # a frame's members: the bar's k too
+            g.append(p[3 * n:])
     lower = [np.full(sum(e.shape[0] for e in g), pb.margin)]
     if pb.mmap is not None:
         mass = pb.mmap.conditions(x[pb.n_q:])
