@@ -293,14 +293,18 @@ def cmd_compare(args) -> int:
 
 
 def _is_frame(path) -> bool:
-    """Whether a model file is a plane frame (a file that does not read is left to the
-    beam path, whose errors say why)."""
-    from .model import load_model
+    """Whether a model file says ``kind = "frame"`` (a file that is not TOML is left to
+    the beam path, whose errors say why; a frame file with a bad field to the frame path,
+    whose error names that field)."""
+    import tomllib
+
+    from .inputs import read_text
 
     try:
-        return load_model(path, frames=True).kind == "frame"
-    except GfeInputError:
+        data = tomllib.loads(read_text(path, "model"))
+    except (GfeInputError, tomllib.TOMLDecodeError, RecursionError):
         return False
+    return isinstance(data, dict) and data.get("kind") == "frame"
 
 
 def _compare_frame(args) -> int:

@@ -276,7 +276,9 @@ class Diagnosis:
             return list(self.suggested)
         out = []
         for e in fit.effects[len(fit.effects) - len(self.suggested):]:
-            place = effect_type(e.name).fixed_keys(fit.model)
+            # a profile's knots are chosen again by update, as the diagnosis chose them
+            place = [k for k in effect_type(e.name).fixed_keys(fit.model)
+                     if not isinstance(e.parameters[k], (list, tuple))]
             out.append(e.name + ":" + ",".join(f"{k}={e.parameters[k]}" for k in place)
                        if place else e.name)
         return out
@@ -515,10 +517,13 @@ def _preferred(fit, other) -> bool:
     return fit.misfit.chi2 < other.misfit.chi2 - TIE * max(other.misfit.chi2, 1.0)
 
 
-def _fit_profile(model, measured, name, noise, x, start_ratio):
-    """Fit a profile with knots ``x``, started from ``start_ratio`` (None: 1 everywhere)."""
+def _fit_profile(model, measured, name, noise, x, start_ratio, member=None):
+    """Fit a profile with knots ``x`` (on a frame along ``member``), started from
+    ``start_ratio`` (None: 1 everywhere)."""
     ratio = list(start_ratio) if start_ratio is not None else [1.0] * len(x)
-    return fit_effects(model, measured, [Effect(name, {"x": list(x), "ratio": ratio})],
+    place = {} if member is None else {"member": member}
+    return fit_effects(model, measured, [Effect(name, {**place, "x": [float(v) for v in x],
+                                                       "ratio": ratio})],
                        noise=noise, name=name)
 
 
@@ -1160,29 +1165,41 @@ def _rank(fits, sel) -> list:
     return [fits[i] for i in ranked([sel.penalised(f) for f in fits])]
 
 
-def _fallback(model, measured, noise, names, sel, band, progress):
+def _fallback(model, measured, noise, names, sel, band, progress, members=None):
     """The profiles: each knot set fitted (in parallel), the coarsest that no finer one
-    beats significantly kept; the mass profile only if the stiffness one does not fit."""
+    beats significantly kept; the mass profile only if the stiffness one does not fit.  On
+    a frame each member (or those of ``members``) is tried."""
     chosen = None
+    # a beam's profile spans it; a frame's lies along one member (each member tried)
+    spans = ([(m.id, model.member_length(m)) for m in model.members
+              if members is None or m.id in members]
+             if model.kind == "frame" else [(None, model.length)])
+    # m modes determine about 2m - 1 knots of a profile; on a frame a member's share of
+    # them (the modes' curvature is spread over its members)
+    per_span = measured.n_modes / (len(model.members) if model.kind == "frame" else 1)
     for name in names:
         kind = effect_type(name)
-        counts = [k for k in kind.knot_counts if k <= max(2, 2 * measured.n_modes - 1)]
-        jobs, labels = [], []
-        for k in counts:
-            x = np.linspace(0.0, model.length, k)
-            jobs.append(("profile", (model, measured, name, noise, x,
-                                     kind.start_ratio(band, model, x))))
-            labels.append(f"{name} ({k} knots)")
-        profiles = [f for f in _run_jobs(jobs, progress, labels) if f.success]
-        if not profiles:
-            continue
-        pick = profiles[0]
-        for finer in profiles[1:]:
-            if sel.better(finer, pick, 1.0 - SIGNIFICANCE_LEVEL):
-                pick = finer
-        if chosen is None or sel.better(pick, chosen, 1.0 - SIGNIFICANCE_LEVEL):
-            chosen = pick
-        if fits_noise(chosen.misfit, chosen.n_params):
+        counts = [k for k in kind.knot_counts if k <= max(2, 2 * per_span - 1)]
+        jobs, labels, groups = [], [], []
+        for member, length in spans:
+            for k in counts:
+                x = np.linspace(0.0, length, k)
+                jobs.append(("profile", (model, measured, name, noise, x,
+                                         kind.start_ratio(band, model, x, member), member)))
+                labels.append(f"{name} ({k} knots" + (f" on {member})" if member else ")"))
+                groups.append(member)
+        done = _run_jobs(jobs, progress, labels)
+        for member, _ in spans:   # per place: the coarsest no finer one beats significantly
+            profiles = [f for f, g in zip(done, groups) if g == member and f.success]
+            if not profiles:
+                continue
+            pick = profiles[0]
+            for finer in profiles[1:]:
+                if sel.better(finer, pick, 1.0 - SIGNIFICANCE_LEVEL):
+                    pick = finer
+            if chosen is None or sel.better(pick, chosen, 1.0 - SIGNIFICANCE_LEVEL):
+                chosen = pick
+        if chosen is not None and fits_noise(chosen.misfit, chosen.n_params):
             break
     return chosen
 
@@ -1751,15 +1768,24 @@ def _profile_start(model, measured, effect, noise):
     if "x" in effect.parameters and "ratio" in effect.parameters:
         return effect
     kind = effect_type(effect.name)
+    member = effect.parameters.get("member")
+    if model.kind == "frame" and member is None:
+        raise GfeInputError("--add", effect.name, "a stiffness_profile on a frame needs its "
+                            "member: --add stiffness_profile:member=ID")
+    if model.kind == "frame" and "x" in effect.parameters:   # ratios from 1
+        x = effect.parameters["x"]
+        return Effect(effect.name, {"member": member, "x": list(x), "ratio": [1.0] * len(x)})
     band = _generic_update(model, measured, noise)[1] if model.kind == "beam" else None
     if "x" in effect.parameters:
         x = effect.parameters["x"]
         start = kind.start_ratio(band, model, np.asarray(x)) or [1.0] * len(x)
         return Effect(effect.name, {"x": list(x), "ratio": list(start)})
-    C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    C = None if model.kind == "frame" else sensor_matrix(model.nodes, model.kind, measured.x,
+                                                         measured.dof, measured.source)
     ref = misfit(model, measured, noise, C)
     sel = _Selection(ref.chi2, 0, 1, measured.n_modes)
-    chosen = _fallback(model, measured, noise, [effect.name], sel, band, None)
+    chosen = _fallback(model, measured, noise, [effect.name], sel, band, None,
+                       None if member is None else [member])
     if chosen is None:
         raise GfeSolverError(f"the {effect.name} could not be fitted")
     return Effect(effect.name, chosen.parameters)

@@ -51,7 +51,7 @@ from .errors import GfeInputError
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
                  "point_mass", "point_spring", "axial_stiffness", "material", "section_loss",
-                 "axial_load", "foundation", "shear")
+                 "axial_load", "foundation", "shear", "stiffness_profile")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -340,6 +340,20 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
         return _as_effect({"effect": name, "member": member_id, "ratio": ratio})
     if name == "section_loss":
         return _section_loss(model, member, raw, where, prefix)
+    if name == "stiffness_profile":   # EI(x) along the member, knots from its start
+        from .effects import effect_type
+
+        no_unknown(raw, {"effect", "member", "x", "ratio"}, where, prefix)
+        kind = effect_type(name)
+        for key in ("x", "ratio"):
+            if key not in raw:
+                raise GfeInputError(where, prefix + key, "missing (a stiffness_profile on "
+                                    "a frame needs member, x and ratio)")
+        x = kind.parameter("x").check(raw["x"], model, where, prefix + "x",
+                                      length=model.member_length(member))
+        ratio = kind.parameter("ratio").check(raw["ratio"], model, where, prefix + "ratio")
+        kind.check(model, {"x": x, "ratio": ratio}, where, prefix)
+        return _as_effect({"effect": name, "member": member_id, "x": x, "ratio": ratio})
     if name == "foundation":
         no_unknown(raw, {"effect", "member", "stiffness"}, where, prefix)
         return _as_effect({"effect": name, "member": member_id, "stiffness": _number(
@@ -510,7 +524,7 @@ def _effect_key(effect) -> tuple | None:
         return None
     if e["effect"] in ("material", "shear"):
         return (e["effect"],)
-    if e["effect"] in ("axial_stiffness", "axial_load", "foundation"):
+    if e["effect"] in ("axial_stiffness", "axial_load", "foundation", "stiffness_profile"):
         return (e["effect"], e["member"]) if "member" in e else None
     if "node" not in e:
         return None   # --add without a place: every place is tried
@@ -688,7 +702,8 @@ def _zoned_elements(zones, step: float, count: int) -> list[int]:
 
 #: the effects that change a member's elements (the others act at joints, supports and
 #: places: springs, masses, applied in :func:`frame_matrices`)
-_ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness", "axial_load", "foundation")
+_ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness", "axial_load", "foundation",
+                    "stiffness_profile")
 
 
 @dataclass(frozen=True)
@@ -719,8 +734,9 @@ _MEMBER_ELEMENTS_KEPT = 256
 def _member_key(model: FrameModel, k: int, raw: list) -> tuple:
     m = model.members[k]
     return (m, tuple(model.nodes[m.start]), tuple(model.nodes[m.end]), model.stiffness_factor,
-            shear_rigidity(model), tuple(tuple(e.items()) for e in raw
-                  if e["effect"] in _ELEMENT_EFFECTS and e["member"] == m.id))
+            shear_rigidity(model), tuple(
+                tuple((k, tuple(v) if isinstance(v, list) else v) for k, v in e.items())
+                for e in raw if e["effect"] in _ELEMENT_EFFECTS and e["member"] == m.id))
 
 
 def member_elements(model: FrameModel) -> list[MemberElements]:
@@ -746,14 +762,18 @@ def member_elements(model: FrameModel) -> list[MemberElements]:
 def _member_bending(model: FrameModel, member: Member, L: float) -> np.ndarray:
     """(n, 3): k_ww, k_wθ, k_θθ of each element of ``member`` (each ``L`` long) [N m²]
     (eq. 11): Euler–Bernoulli, or the exact static element of EI(x) where a crack's
-    disturbance or a section loss's zone (EI × its stiffness ratio) reaches."""
+    disturbance or a section loss's zone (EI × its stiffness ratio) reaches, and on every
+    element of a member with a ``stiffness_profile`` (EI × its piecewise-linear ratio)."""
     ei0 = model.stiffness_factor * member.E * member.inertia
     EI = np.full(member.elements, ei0)
     out = np.stack([12.0 * EI, 6.0 * EI, 4.0 * EI], axis=1)
     cracks = [(e["position"], e["depth_ratio"]) for e in model.raw_effects
               if e["effect"] == "crack" and e["member"] == member.id]
     zones = _zones(model, member.id)
-    if not cracks and not zones:
+    profile = next(((np.asarray(e["x"], float), np.asarray(e["ratio"], float))
+                    for e in model.raw_effects
+                    if e["effect"] == "stiffness_profile" and e["member"] == member.id), None)
+    if not cracks and not zones and profile is None:
         return out
     from .effects.crack import CRACK_REACH
 
@@ -763,18 +783,23 @@ def _member_bending(model: FrameModel, member: Member, L: float) -> np.ndarray:
 
     def rigidity(x):
         q = zoned(x)
+        if profile is not None:
+            q = q * np.interp(x, *profile)
         for x_c, ratio in cracks:
             q = q * el.christides_barr_q(x, x_c, ratio, half)
         return ei0 * q
 
     reached = set(_zoned_elements(zones, L, member.elements))
+    if profile is not None:
+        reached = set(range(member.elements))
     for x_c, _ in cracks:
         lo = max(int((x_c - CRACK_REACH * decay) // L), 0)
         hi = min(int((x_c + CRACK_REACH * decay) // L) + 1, member.elements)
         reached.update(range(lo, hi))
     for j in sorted(reached):
         x0 = j * L
-        inside = (*(x_c for x_c, _ in cracks if x0 < x_c < x0 + L), *_edges(zones, x0, L))
+        inside = (*(x_c for x_c, _ in cracks if x0 < x_c < x0 + L), *_edges(zones, x0, L),
+                  *(() if profile is None else (k for k in profile[0] if x0 < k < x0 + L)))
         out[j] = el.beam_stiffness_from_flexibility(rigidity, x0, L, breakpoints=inside,
                                                     refine_scale=decay)
     return out

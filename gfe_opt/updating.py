@@ -755,6 +755,8 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
     disc, par, regularisation = _setup(model, parameterisation, regularisation,
                                        full_shapes is not None)
     start = time.perf_counter()
+    if q0 is None:   # the initial model's parameters, once (every refinement anchors there)
+        q0 = par.fit(disc.stiffness_params)
 
     def prepare(expansion_disc=None, kmap=None):
         return _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes,

@@ -41,6 +41,10 @@ drawn from the seed:
   member solving EI w⁗ + (k_f − ρAω²) w = 0; the answer a ``foundation`` under that
   member, its size k_f.  The classes after the tenth draw their cases from seeds of their
   own (seed + 1000 + 10 i + their index past the tenth), so the first ten keep theirs;
+* ``taper``: a member drawn at random whose EI varies linearly from the modelled at its
+  start node to 0.55 to 0.85 or 1.2 to 1.8 times it at its end (log-uniform; ρA and EA as
+  modelled), exact as 60 uniform members (``tests/frame_reference.py`` ``taper_frame``); the
+  answer a ``stiffness_profile`` on that member, its size its ratio at the member's end;
 * ``deep``: the portal with every member 0.02 to 0.08 m deep (log-uniform; ℓ/h 3.75 to 20;
   the model is that deep portal, Euler–Bernoulli) measured from the exact frame of
   Timoshenko members (κGA = 5/6 G A, rotary inertia ρI; ``tests/frame_reference.py``); the
@@ -95,12 +99,12 @@ from gfe_opt.diagnosis import diagnose  # noqa: E402
 from gfe_opt.frame import frame_modes  # noqa: E402
 from gfe_opt.model import Effect  # noqa: E402
 from gfe_opt.problems import portal_frame  # noqa: E402
-from tests.frame_reference import ExactFrame, self_stress, zone_frame  # noqa: E402
+from tests.frame_reference import ExactFrame, self_stress, taper_frame, zone_frame  # noqa: E402
 from tests.test_frame import deep_portal  # noqa: E402
 from tests.test_frame_diagnosis import NOISE, _braced_portal, _exact, _guess, _measured, _sensors  # noqa: E402
 
 CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material", "zone", "tension",
-           "lean", "ground", "deep")
+           "lean", "ground", "deep", "taper")
 POSITION_TOLERANCE = 0.02
 DETECTABLE = 2.0     # first chi2/n at the stated noise below which a change is noise
 
@@ -197,6 +201,14 @@ def make_case(seed: int, group: str) -> dict:
                            ids)
         bracket = [Effect("foundation", {"member": member.id, "stiffness": kf})]
         answers = [{"name": "foundation", "member": member.id, "size": kf}]
+    elif group == "taper":
+        member = model.members[int(rng.integers(len(ids)))]
+        r = _log_uniform(rng, 0.55, 0.85) if rng.random() < 0.5 else \
+            _log_uniform(rng, 1.2, 1.8)
+        exact, where = taper_frame(model, member.id, r)
+        bracket = [Effect("stiffness_profile", {"member": member.id, "x": [
+            0.0, model.member_length(member)], "ratio": [1.0, r]})]
+        answers = [{"name": "stiffness_profile", "member": member.id, "size": r}]
     elif group == "deep":
         model, exact, bracket = deep_portal(_log_uniform(rng, 0.02, 0.08))
         answers = [{"name": "shear", "size": bracket[0].parameters["shear_rigidity"]}]
@@ -279,7 +291,7 @@ def _matches(model, effect: Effect, answer: dict) -> bool:
     if answer["name"] in ("crack", "section_loss", "point_spring"):
         return p.get("member") == answer["member"] and abs(
             p["position"] - answer["position"]) <= POSITION_TOLERANCE * answer["length"]
-    if answer["name"] in ("axial_load", "foundation"):
+    if answer["name"] in ("axial_load", "foundation", "stiffness_profile"):
         return p.get("member") == answer["member"]
     if answer["name"] == "point_mass":
         member = model.member(p["member"])
@@ -295,6 +307,8 @@ def _size(model, effect: Effect):
     if effect.name == "section_loss":   # the added bending compliance (rad / (N m))
         m = model.member(p["member"])
         return p["length"] * (1 / p["stiffness_ratio"] - 1) / (m.E * m.inertia)
+    if effect.name == "stiffness_profile":   # EI at the member's end over the modelled
+        return p["ratio"][-1]
     return p.get("stiffness", p.get("mass", p.get("E", p.get("tension",
                                                              p.get("shear_rigidity")))))
 

@@ -66,8 +66,9 @@ class Parameter:
             return "positive numbers, one per knot"
         return "a finite number"
 
-    def check(self, value, model, where: str, field: str):
-        """The value, validated (lists as lists of floats); raises :class:`GfeInputError`."""
+    def check(self, value, model, where: str, field: str, length: float | None = None):
+        """The value, validated (lists as lists of floats); raises :class:`GfeInputError`.
+        ``length``: what knots span (a frame member's; default the structure's)."""
         if self.rule == "choice":
             if value not in self.choices:
                 raise GfeInputError(where, field, f"must be {self.describe_range(model)}, "
@@ -83,11 +84,12 @@ class Parameter:
                     raise GfeInputError(where, f"{field}[{bad[0]}]", "must lie in (0, 100], "
                                         f"got {values[bad[0]]:g}")
             else:
-                tol = 1e-9 * model.length
-                if abs(values[0]) > tol or abs(values[-1] - model.length) > tol:
-                    raise GfeInputError(where, field, f"must run from 0 to {model.length:g} m "
-                                        f"(the whole structure), got {values[0]:g} to "
-                                        f"{values[-1]:g}")
+                span = model.length if length is None else length
+                tol = 1e-9 * span
+                if abs(values[0]) > tol or abs(values[-1] - span) > tol:
+                    what = "the whole structure" if length is None else "the whole member"
+                    raise GfeInputError(where, field, f"must run from 0 to {span:g} m "
+                                        f"({what}), got {values[0]:g} to {values[-1]:g}")
                 if np.any(np.diff(values) <= 0):
                     raise GfeInputError(where, field, "positions must increase")
             return values

@@ -47,8 +47,8 @@ class ProfileEffect(EffectType):
     def variables(self, model, fixed):
         return [Variable("ratio", 0.05, 3.0, (1.0,), index=i) for i in range(len(fixed["x"]))]
 
-    def start_ratio(self, band, model, x):
-        """Starting ratios at knots x (None: 1 everywhere)."""
+    def start_ratio(self, band, model, x, member=None):
+        """Starting ratios at knots x (on a frame along ``member``; None: 1 everywhere)."""
         return None
 
     def starts(self, model, hint):
