@@ -23,10 +23,8 @@ from gfe_opt import realisation  # noqa: E402
 from gfe_opt.diagnosis import _generic_only  # noqa: E402
 from gfe_opt.fitting import noise_of  # noqa: E402
 from gfe_opt.frame import FrameDiscretisation  # noqa: E402
-from gfe_opt.model import Effect  # noqa: E402
 from gfe_opt.problems import portal_frame  # noqa: E402
-from tests.frame_reference import ExactFrame  # noqa: E402
-from tests.test_frame_diagnosis import NOISE, _braced_portal, _exact, _guess, _measured, _sensors  # noqa: E402
+from tests.test_frame_diagnosis import NOISE, _exact, _guess, _measured, _sensors, loose_brace  # noqa: E402
 
 
 def _features(model, measured, noise, samples):
@@ -36,20 +34,6 @@ def _features(model, measured, noise, samples):
     band = realisation.profile_band(FrameDiscretisation(model), measured, result, noise,
                                     samples=samples)
     return [(m, f.kind, what, round(float(f.value), 3)) for m, _, f, what in band.features]
-
-
-def _loose_brace(ratio):
-    model = _braced_portal()
-    members = []
-    for m in model.members:
-        props = (m.E, m.rho, m.area, m.inertia)
-        if m.id == "brace":   # EA × ratio, EI and ρA kept
-            props = (ratio * m.E, m.rho, m.area, m.inertia / ratio)
-        members.append((m.start, m.end, *props))
-    exact = ExactFrame(model.nodes, members, dict(model.supports), (),
-                       [m.id for m in model.members])
-    guess = _guess(model, [Effect("axial_stiffness", {"member": "brace", "ratio": ratio})])
-    return model, exact, guess
 
 
 def main():
@@ -68,7 +52,7 @@ def main():
                                            for m in portal.members))
     cases = {"as modelled": (portal, _exact(portal), _guess(portal, [])),
              "beam E x 0.9": (portal, _exact(softer), _guess(softer, [])),
-             "brace EA x 0.4": _loose_brace(0.4)}
+             "brace EA x 0.4": loose_brace(0.4)}
     counts = {"none_clean": 0, "beam_first": 0, "beam_alone": 0, "brace_first": 0, "seeds": 0}
     for seed in range(first, last + 1):
         found = {}

@@ -19,15 +19,14 @@ from gfe_opt.problems import portal_frame
 from gfe_opt.realisation import describe_profile, profile_band
 from gfe_opt.updating import stiffness_map
 
-from .frame_reference import ExactFrame
 from .test_frame_diagnosis import (
     NOISE,
-    _braced_portal,
     _exact,
     _guess,
     _measured,
     _sensors,
     line_spring_column,
+    loose_brace,
 )
 
 STATED = noise_of(NOISE["freq_noise"], NOISE["shape_noise"])
@@ -150,17 +149,8 @@ def test_a_loose_brace_reads_as_a_lower_ea_of_that_brace_first():
     0.4 E and I I/0.4, so EI and ρA kept): the most significant feature of the generic
     update is a uniform change of the brace's EA, at least half way from the model to the
     truth (the regularisation holds the update towards the model: it reads 0.59)."""
-    model = _braced_portal()
-    members = []
-    for m in model.members:
-        props = (m.E, m.rho, m.area, m.inertia)
-        if m.id == "brace":
-            props = (0.4 * m.E, m.rho, m.area, m.inertia / 0.4)
-        members.append((m.start, m.end, *props))
-    exact = ExactFrame(model.nodes, members, dict(model.supports), (),
-                       [m.id for m in model.members])
-    truth = [Effect("axial_stiffness", {"member": "brace", "ratio": 0.4})]
-    measured = _measured(model, exact, _guess(model, truth), _sensors(model), 17)
+    model, exact, guess = loose_brace(0.4)
+    measured = _measured(model, exact, guess, _sensors(model), 17)
     result, band = _band(model, measured)
     member, _, first, what = band.features[0]
     assert (member, first.kind, what) == ("brace", "uniform", "EA"), describe_profile(band)
@@ -168,3 +158,26 @@ def test_a_loose_brace_reads_as_a_lower_ea_of_that_brace_first():
     ea = member_ratios(result, axial=True)
     assert np.median(ea["brace"][1]) < min(np.min(r) for m, (_, r) in ea.items()
                                            if m != "brace")
+
+
+def test_diagnose_reads_the_loose_brace_in_words_and_figures_from_one_result():
+    """``diagnose(realise=True)`` on a frame (one candidate, to keep it short): the words
+    read the brace's EA first and say the fitted axial stiffness reproduces it; the figure
+    draws the same band (the brace's EA panel, the fitted effect's reading dashed)."""
+    from gfe_opt.diagnosis import diagnose
+    from gfe_opt.report import diagnosis_figures
+
+    model, exact, guess = loose_brace(0.4)
+    measured = _measured(model, exact, guess, _sensors(model), 17)
+    d = diagnose(model, measured, candidates=["axial_stiffness"], realise=True, **NOISE)
+    assert d.add_arguments() == ["axial_stiffness:member=brace"]
+    assert d.realisation[0].startswith("brace (x from A): a uniform change of EA: 0.5")
+    assert d.realisation[0].endswith("(the fitted axial_stiffness's own modes show it too)")
+    assert d.to_json()["realisation"] == d.realisation
+    fig = diagnosis_figures(d, model)["stiffness_change.png"]
+    panel = next(ax for ax in fig.axes if ax.get_title().startswith("brace: EA"))
+    lines = {ln.get_label(): ln.get_ydata() for ln in panel.get_lines()}
+    brace = next(b for m, _, b, what in d.profile_band.members if (m, what) == ("brace", "EA"))
+    assert np.array_equal(lines["generic update of the test"], brace.ratio)
+    assert np.array_equal(lines["the same, of the fitted axial_stiffness's modes"],
+                          brace.explained)
