@@ -547,7 +547,7 @@ def _zone(**changes):
     (lambda d: d["members"][1].update({"elements": 0}), "members[1].elements"),
     (lambda d: d.update({"effects": [{"effect": "joint_spring", "member": "beam",
                                       "node": "A", "stiffness": 10.0}]}), "effects[0].node"),
-    (lambda d: d.update({"effects": [{"effect": "stiffness_profile", "member": "beam"}]}),
+    (lambda d: d.update({"effects": [{"effect": "mass_profile", "member": "beam"}]}),
      "effects[0].effect"),
     (lambda d: d.update({"effects": [{"effect": "shear", "member": "beam",
                                       "shear_rigidity": 1e7}]}), "effects[0].member"),
@@ -1011,7 +1011,7 @@ def test_cli_update_on_a_frame(tmp_path):
     assert bad.returncode == 2 and "does not end at node 'A'" in bad.stderr
     assert len(bad.stderr.strip().splitlines()) == 1
     profile = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
-                              "stiffness_profile"], capture_output=True, text=True)
+                              "mass_profile"], capture_output=True, text=True)
     assert profile.returncode == 2 and "not fitted on frames yet" in profile.stderr
     assert len(profile.stderr.strip().splitlines()) == 1
     twice = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data] + [
