@@ -108,7 +108,9 @@ def _profile_panel(ax, band, label, legend=True, quantity="EI"):
             continue
         grey = f in band.unexplained and band.explained is not None
         text = "collapsed" if f.value <= COLLAPSED else f"{f.value:.2f}±{f.sigma:.2g}"
-        ax.annotate(text, (f.x, f.value), textcoords="offset points",
+        # at the curve: a local value is read against the profile's level (its trend)
+        at = f.value * float(np.interp(f.x, band.x, band.trend))
+        ax.annotate(text, (f.x, at), textcoords="offset points",
                     xytext=(0, -12 if f.kind == "loss" else 6), ha="center", fontsize=7,
                     color="0.45" if grey else "black")
     ax.axhline(1.0, color="0.4", lw=0.8)

@@ -280,9 +280,12 @@ class Feature:
     start: float = 1.0
     significance: float = 0.0   # in standard deviations (what orders features)
 
-    def describe(self, ends=("the left end", "the right end"), quantity="EI") -> str:
+    def describe(self, ends=("the left end", "the right end"), quantity="EI",
+                 level: float = 1.0) -> str:
         """In words; ``ends`` name where x starts and ends (a frame member's nodes),
-        ``quantity`` what was read: ``"EI"`` (bending) or ``"EA"`` (a member's axial)."""
+        ``quantity`` what was read: ``"EI"`` (bending) or ``"EA"`` (a member's axial);
+        ``level`` the profile's level a local feature stands out from (a frame member's,
+        when it is not the model's)."""
         axial = quantity == "EA"
         if self.kind == "uniform":
             why = "a looser or thinner member" if axial else "a material change"
@@ -299,6 +302,11 @@ class Feature:
             return (f"the update collapses near x = {self.x:.3f} m ({extent}): k = "
                     f"{self.value:.2f} of the model's, no physical reading (the nodal family "
                     "cannot fit the data there)")
+        if level != 1.0:   # against the member's own level, said as such
+            return (f"a local {word} near x = {self.x:.3f} m ({extent}): k = "
+                    f"{self.value * level:.2f} of the model's, {self.value:.2f} ± "
+                    f"{self.sigma:.2g} of the member's level there ({level:.2f} of the "
+                    "model's)")
         return (f"a local {word} near x = {self.x:.3f} m ({extent}): "
                 f"k = {self.value:.2f} ± {self.sigma:.2g} of the model's")
 
@@ -661,8 +669,15 @@ def describe_profile(band: ProfileBand, effect: str | None = None,
         return [f"no change of the {what} beyond the noise band (±{width:.1f} %)"]
     if isinstance(band, FrameProfileBand):
         ends = {m.id: (m.start, m.end) for m in band.model_members}
+        bands = {(m, what): b for m, _, b, what in band.members}
+
+        def level(m, f, what):   # a local feature stands out from its member's level
+            b = bands[m, what]
+            return float(np.interp(f.x, b.x, b.trend)) if f.kind in ("loss", "rise") \
+                and f.value > COLLAPSED else 1.0
+
         features = [((m, f, what), f"{m} (x from {start}): "
-                     f"{f.describe(tuple(f'node {n}' for n in ends[m]), what)}")
+                     f"{f.describe(tuple(f'node {n}' for n in ends[m]), what, level(m, f, what))}")
                     for m, start, f, what in band.features]
         unexplained = [(m, f, what) for m, _, f, what in band.unexplained]
         explained = band.members[0][2].explained is not None
