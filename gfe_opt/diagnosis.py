@@ -1189,7 +1189,6 @@ def _fallback(model, measured, noise, names, sel, band, progress, members=None):
                 labels.append(f"{name} ({k} knots" + (f" on {member})" if member else ")"))
                 groups.append(member)
         done = _run_jobs(jobs, progress, labels)
-        picks = []
         for member, _ in spans:   # per place: the coarsest no finer one beats significantly
             profiles = [f for f, g in zip(done, groups) if g == member and f.success]
             if not profiles:
@@ -1198,9 +1197,6 @@ def _fallback(model, measured, noise, names, sel, band, progress, members=None):
             for finer in profiles[1:]:
                 if sel.better(finer, pick, 1.0 - SIGNIFICANCE_LEVEL):
                     pick = finer
-            picks.append(pick)
-        if picks:   # the places' picks by the information criterion (a beam has one place)
-            pick = picks[ranked([sel.penalised(f) for f in picks])[0]]
             if chosen is None or sel.better(pick, chosen, 1.0 - SIGNIFICANCE_LEVEL):
                 chosen = pick
         if chosen is not None and fits_noise(chosen.misfit, chosen.n_params):
