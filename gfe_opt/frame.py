@@ -869,11 +869,8 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
         g = el.shear_parameter(p[:, 0] / 12.0, kGA, L)
         soft = el.timoshenko_correction({"k_ww": p[:, 0], "k_wt": p[:, 1], "k_tt": p[:, 2]}, g)
         p = np.stack([soft["k_ww"], soft["k_wt"], soft["k_tt"]], axis=1)
-    P = np.stack([np.stack([p[:, 0], p[:, 1]], -1), np.stack([p[:, 1], p[:, 2]], -1)], -2)
-    H = el.BEAM_DEFORMATION_H
+    local_k[np.ix_(range(n), bend, bend)] = bending_stiffness(p, L)
     scaling = el.beam_dof_scaling(L)                     # (n, 4)
-    scaled = np.einsum("ji,ejk,kl->eil", H, P, H) / L[:, None, None] ** 3
-    local_k[np.ix_(range(n), bend, bend)] = scaled * scaling[:, :, None] * scaling[:, None, :]
     if kGA is None:
         mass_params = el.CONSISTENT_BEAM_MASS
     else:   # eq. 18's translational mass and the rotary inertia ρI, g of the member's EI
@@ -900,6 +897,17 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
     Tt = np.swapaxes(T, 1, 2)
     return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension, foundation, g)
+
+
+def bending_stiffness(p, L) -> np.ndarray:
+    """(n, 4, 4) eq. 11's generic beam stiffness H^T P H / L³ in the physical DOFs
+    [w, θ, w, θ] of n elements of lengths ``L``, ``p`` (n, 3) their k_ww, k_wθ, k_θθ."""
+    p = np.asarray(p, float)
+    P = np.stack([np.stack([p[:, 0], p[:, 1]], -1), np.stack([p[:, 1], p[:, 2]], -1)], -2)
+    H = el.BEAM_DEFORMATION_H
+    scaling = el.beam_dof_scaling(L)                     # (n, 4)
+    scaled = np.einsum("ji,ejk,kl->eil", H, P, H) / L[:, None, None] ** 3
+    return scaled * scaling[:, :, None] * scaling[:, None, :]
 
 
 def shear_rigidity(model: FrameModel) -> float | None:

@@ -32,7 +32,15 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import lsqr, splu
 
 from . import elements as el
-from .frame import FrameModel, _assemble, frame_matrices, frame_mesh, member_elements, rotations
+from .frame import (
+    FrameModel,
+    _assemble,
+    bending_stiffness,
+    frame_matrices,
+    frame_mesh,
+    member_elements,
+    rotations,
+)
 from .parameterisation import (
     BEAM_KEYS,
     Parameterisation,
@@ -40,10 +48,6 @@ from .parameterisation import (
     beam_parameterisation,
 )
 
-#: the unit P of each generic bending parameter (k_ww, k_wθ, k_θθ)
-_UNIT_P = {"k_ww": np.array([[1.0, 0.0], [0.0, 0.0]]),
-           "k_wt": np.array([[0.0, 1.0], [1.0, 0.0]]),
-           "k_tt": np.array([[0.0, 0.0], [0.0, 1.0]])}
 _BEND = [1, 2, 4, 5]
 _AXIAL = [0, 3]
 #: the generic parameters of a frame's element: bending (eq. 11), then axial (eq. 2, EA)
@@ -72,21 +76,17 @@ class FrameGeneric:
         self.constrained = self.mesh.constrained
         self.free = np.setdiff1d(np.arange(self.n_dof), self.constrained)
         self.element_length = self.mesh.element_length
-        L = self.element_length
-        H = el.BEAM_DEFORMATION_H
-        scaling = el.beam_dof_scaling(L)
+        L, n = self.element_length, self.n_elements
         T = rotations(self.mesh.cosines)
         Tt = np.swapaxes(T, 1, 2)
-        self._units = {}
-        for key, P in _UNIT_P.items():
-            local = np.zeros((self.n_elements, 6, 6))
-            scaled = (H.T @ P @ H)[None] / L[:, None, None] ** 3
-            local[np.ix_(range(self.n_elements), _BEND, _BEND)] = \
-                scaled * scaling[:, :, None] * scaling[:, None, :]
+        self._units = {}   # each generic parameter's unit element, from the frame's formulas
+        for i, key in enumerate(BEAM_KEYS):
+            local = np.zeros((n, 6, 6))
+            local[np.ix_(range(n), _BEND, _BEND)] = bending_stiffness(
+                np.repeat(np.eye(3)[i][None], n, axis=0), L)
             self._units[key] = Tt @ local @ T
-        local = np.zeros((self.n_elements, 6, 6))
-        local[np.ix_(range(self.n_elements), _AXIAL, _AXIAL)] = \
-            np.array([[1.0, -1.0], [-1.0, 1.0]])[None] / L[:, None, None]
+        local = np.zeros((n, 6, 6))
+        local[np.ix_(range(n), _AXIAL, _AXIAL)] = el.generic_bar_stiffness(np.ones(n), L)
         self._units["k"] = Tt @ local @ T
         K, self._M = frame_matrices(model, self.mesh)
         self._rest = (K - self._generic(self.stiffness_params)).tocsr()
