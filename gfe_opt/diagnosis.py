@@ -243,7 +243,7 @@ class Diagnosis:
     suggested: list = field(default_factory=list)     # effect names to add (update --add)
     together: Fit | None = None                       # the suggested pair's fit
     realisation: list = field(default_factory=list)   # the generic update in words
-    nodal: list = field(default_factory=list)         # Realisation per node
+    nodal: list = field(default_factory=list)   # Realisation per node (a frame's a member)
     generic_update: object = None                     # the UpdateResult they come from
     profile_band: object = None                       # ProfileBand of the generic update
     notes: list = field(default_factory=list)
@@ -953,6 +953,10 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
 
         if generic.ok and model.kind == "beam":
             nodal = realise_rows(generic.discretisation, _discretise(model))
+        elif generic.ok and model.kind == "frame":
+            from .realisation import realise_members
+
+            nodal = realise_members(generic.discretisation, _discretise(model))
         found = ranked[0] if ranked and ranked[0].significant else None
         if band is not None and found is not None:
             from .realisation import noisy_copies

@@ -352,6 +352,63 @@ def nodal_coefficients(realisations, bending_rigidity=None, length=None):
     return fig
 
 
+def frame_nodal_coefficients(members):
+    """A frame's :func:`nodal_coefficients`: each member's interior nodes read in its own
+    axes (:class:`~gfe_opt.realisation.MemberRealisation`), one curve a member against the
+    distance from its start node over its length: k/k0 and EA/EA0, the axial force T beyond
+    the model's, the foundation k_f beyond the model's; each member whose T or k_f holds one
+    value along it is named with that value."""
+    from .realisation import uniform_term
+
+    fig = _figure(7.0, 5.8)
+    top, middle, bottom = fig.subplots(3, 1, sharex=True)
+    from matplotlib import rcParams
+
+    colours = rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, m in enumerate(members):
+        colour = colours[i % len(colours)]
+        s = [r.x / m.length for r in m.rows]
+        top.plot(s, [r.k_ratio for r in m.rows], "o-", ms=2.5, color=colour,
+                 label=f"{m.member} (from {m.start}): $k/k_0$")
+        top.plot(s, m.axial_ratio, "--", lw=1.0, color=colour,
+                 label=f"{m.member}: $EA/EA_0$")
+        middle.plot(s, np.array([r.tension for r in m.rows]) / 1e3, "o-", ms=2.5,
+                    color=colour)
+        bottom.plot(s, np.array([r.foundation for r in m.rows]) / 1e6, "s-", ms=2.5,
+                    color=colour)
+    top.axhline(1.0, color="0.5", lw=0.8)
+    top.set_ylabel("ratio to the model")
+    top.legend(fontsize=6, ncol=2)
+    top.set_title("What each member node's updated equation says, in the member's axes:\n"
+                  r"$(k\,w'')'' - T\,w'' + k_f\,w + m\,\ddot w = 0$ across it, "
+                  r"$-(EA\,u')' + m\,\ddot u = 0$ along it", fontsize=9)
+    middle.set_ylabel("axial force\n$T$ [kN]")
+    bottom.set_ylabel("foundation\n$k_f$ [MN/m²]")
+    weakest = min(members, key=lambda m: m.euler_load)
+    for sign in (1, -1):
+        middle.axhline(sign * weakest.euler_load / 1e3, color="0.5", ls="--", lw=0.8,
+                       label=(f"± {weakest.member}'s Euler load $\\pi^2EI/\\ell^2$ (the "
+                              "members' lowest)") if sign > 0 else None)
+    middle.legend(fontsize=7, loc="lower right")
+    for ax, key, unit, scale in ((middle, "tension", "kN", 1e3),
+                                 (bottom, "foundation", "MN/m²", 1e6)):
+        ax.axhline(0.0, color="0.7", lw=0.8)
+        lines = []
+        for m in members:
+            values = [getattr(r, key) for r in m.rows]
+            level = uniform_term(values)
+            if level:
+                lines.append(f"{m.member}: one value along it, {level / scale:.4g} {unit}")
+        if not lines:
+            any_value = any(getattr(r, key) for m in members for r in m.rows)
+            lines = ["no value common to any member: node-to-node scatter (k'' and noise), "
+                     "not a physical term" if any_value else "zero at every node"]
+        ax.text(0.01, 0.9, "\n".join(lines), transform=ax.transAxes, fontsize=7,
+                color="0.3", va="top", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
+    bottom.set_xlabel("distance from the member's start node / its length")
+    return fig
+
+
 def stabilisation(identification):
     """Stabilisation chart: stable poles per model order over the summed FRF magnitude, the
     modes kept marked."""

@@ -159,13 +159,20 @@ def realise(disc: Discretisation, initial: Discretisation, significance: float =
     Terms below ``significance`` of their natural scale (k0 (π/ℓ)², k0 (π/ℓ)⁴ with ℓ the
     length of the structure) are reported as zero.
     """
-    new, old = nodal_equations(disc), nodal_equations(initial)
+    return _compare_rows(nodal_equations(disc), nodal_equations(initial),
+                         disc.nodes[-1] - disc.nodes[0], significance)
+
+
+def _compare_rows(new, old, length: float, significance: float) -> list[Realisation]:
+    """:func:`realise`'s reading of rows ``new`` against ``old`` along a length."""
     x = np.array([e.x for e in new])
     c4 = np.array([e.stiffness[4] for e in new])
     c4_old = np.array([e.stiffness[4] for e in old])
     k0 = float(np.mean(c4_old))
-    length = disc.nodes[-1] - disc.nodes[0]
-    kpp = np.gradient(np.gradient(c4, x), x) - np.gradient(np.gradient(c4_old, x), x)
+    if len(x) >= 3:
+        kpp = np.gradient(np.gradient(c4, x), x) - np.gradient(np.gradient(c4_old, x), x)
+    else:
+        kpp = np.zeros(len(x))
     out = []
     for i, (a, b) in enumerate(zip(new, old)):
         tension = -((a.stiffness[2] - b.stiffness[2]) - kpp[i])
@@ -181,6 +188,24 @@ def realise(disc: Discretisation, initial: Discretisation, significance: float =
     return out
 
 
+def _series(entries, L: float):
+    """One row's Taylor coefficients per unit length from its entries ``(K value, M value,
+    h, d)``: the column's node lies h from the row's, d = 0 a displacement DOF (expands
+    w^(n) h^n/n!), d = 1 a rotation (the slope: w^(n+1) h^n/n!)."""
+    stiff = np.zeros(5)
+    mass = np.zeros(3)
+    for kv, mv, h, d in entries:
+        for n in range(5):
+            p = n - d
+            if p >= 0:
+                stiff[n] += kv * h**p / math.factorial(p)
+        for n in range(3):
+            p = n - d
+            if p >= 0:
+                mass[n] += mv * h**p / math.factorial(p)
+    return stiff / L, mass / L
+
+
 def nodal_equations(disc: Discretisation, K=None, M=None) -> list[NodalEquation]:
     """Numeric Taylor expansion of every interior node's translational row (beam) or row
     (bar) of the assembled K and M; coefficients per unit length (divided by the element
@@ -189,28 +214,84 @@ def nodal_equations(disc: Discretisation, K=None, M=None) -> list[NodalEquation]
         K, M = disc.global_matrices()
     K, M = K.tocsr(), M.tocsr()
     nodes = disc.nodes
-    L = disc.element_length
     per = disc.dofs_per_node
     out = []
     for i in range(1, len(nodes) - 1):
         row = per * i
-        stiff = np.zeros(5)
-        mass = np.zeros(3)
-        for j in (i - 1, i, i + 1):
-            h = nodes[j] - nodes[i]
-            for d in range(per):
-                col = per * j + d
-                kv, mv = K[row, col], M[row, col]
-                # a displacement DOF expands w^(n) h^n/n!; a rotation DOF (slope) w^(n+1) h^n/n!
-                for n in range(5):
-                    p = n - d
-                    if p >= 0:
-                        stiff[n] += kv * h**p / math.factorial(p)
-                for n in range(3):
-                    p = n - d
-                    if p >= 0:
-                        mass[n] += mv * h**p / math.factorial(p)
-        out.append(NodalEquation(float(nodes[i]), stiff / L, mass / L))
+        entries = [(K[row, per * j + d], M[row, per * j + d], nodes[j] - nodes[i], d)
+                   for j in (i - 1, i, i + 1) for d in range(per)]
+        out.append(NodalEquation(float(nodes[i]), *_series(entries, disc.element_length)))
+    return out
+
+
+@dataclass(frozen=True)
+class MemberRealisation:
+    """What a frame member's interior nodes say in the member's own axes: its transverse
+    rows read as a beam's (:class:`Realisation`, x from its start node) and its axial rows'
+    EA / EA0 (the coefficient of u'': -EA for a bar, eq. 8)."""
+
+    member: str
+    start: str
+    length: float
+    rows: tuple
+    axial_ratio: np.ndarray
+    bending_rigidity: float   # the model's EI along it (mean of its 4th-derivative coefficients)
+
+    @property
+    def euler_load(self) -> float:
+        """π² EI / ℓ²: the scale an axial force must reach to matter in its bending."""
+        return float(np.pi**2 * self.bending_rigidity / self.length**2)
+
+
+def member_equations(disc, K=None, M=None) -> dict:
+    """Each frame member's interior nodes Taylor-expanded in the member's axes (the frame's
+    K and M rotated to its transverse and axial directions, its own end rotations where a
+    joint spring frees them): {member: (transverse NodalEquation list, each axial row's
+    coefficient of u'' per unit length)}.  ``disc`` is a frame discretisation or its
+    generic form (``mesh``, ``model``, :meth:`global_matrices`)."""
+    if K is None or M is None:
+        K, M = disc.global_matrices()
+    K, M = K.tocsr(), M.tocsr()
+    mesh = disc.mesh
+    out = {}
+    for k, member in enumerate(disc.model.members):
+        els = np.flatnonzero(mesh.element_member == k)
+        c, s = mesh.cosines[els[0]]
+        L = float(mesh.element_length[els[0]])
+        rows, axial = [], []
+        for p in range(1, len(els)):
+            left, right = mesh.element_dofs[els[p - 1]], mesh.element_dofs[els[p]]
+            nodes = (left[:3], left[3:], right[3:])
+            here = nodes[1]
+            across = {w: -s * W[here[0]].toarray()[0] + c * W[here[1]].toarray()[0]
+                      for w, W in (("K", K), ("M", M))}
+            along = c * K[here[0]].toarray()[0] + s * K[here[1]].toarray()[0]
+            entries = []
+            u2 = 0.0
+            for j, dofs in zip((-1, 0, 1), nodes):
+                h = j * L
+                entries.append((-s * across["K"][dofs[0]] + c * across["K"][dofs[1]],
+                                -s * across["M"][dofs[0]] + c * across["M"][dofs[1]], h, 0))
+                entries.append((across["K"][dofs[2]], across["M"][dofs[2]], h, 1))
+                u2 += (c * along[dofs[0]] + s * along[dofs[1]]) * h**2 / 2.0
+            rows.append(NodalEquation(p * L, *_series(entries, L)))
+            axial.append(u2 / L)
+        out[member.id] = (rows, np.array(axial))
+    return out
+
+
+def realise_members(disc, initial, significance: float = 1e-3) -> list[MemberRealisation]:
+    """:func:`realise` on a frame, member by member in each member's axes (its length the
+    scale of the terms' significance)."""
+    new, old = member_equations(disc), member_equations(initial)
+    out = []
+    for member in disc.model.members:
+        (rows, u2), (rows0, u20) = new[member.id], old[member.id]
+        length = disc.model.member_length(member)
+        out.append(MemberRealisation(member.id, member.start, length,
+                                     tuple(_compare_rows(rows, rows0, length, significance)),
+                                     u2 / u20,
+                                     float(np.mean([r.stiffness[4] for r in rows0]))))
     return out
 
 

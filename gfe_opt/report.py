@@ -66,6 +66,8 @@ def diagnosis_figures(diagnosis, model) -> dict:
             best = diagnosis.best
             figs["stiffness_change.png"] = plots.frame_profiles(
                 diagnosis.profile_band, label=best.name if best else None)
+        if diagnosis.nodal:
+            figs["nodal_equations.png"] = plots.frame_nodal_coefficients(diagnosis.nodal)
         return figs
     figs = {"candidates.png": plots.candidate_errors(
         diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
