@@ -48,7 +48,15 @@ drawn from the seed:
 * ``deep``: the portal with every member 0.02 to 0.08 m deep (log-uniform; ℓ/h 3.75 to 20;
   the model is that deep portal, Euler–Bernoulli) measured from the exact frame of
   Timoshenko members (κGA = 5/6 G A, rotary inertia ρI; ``tests/frame_reference.py``); the
-  answer ``shear``, its size the first member's κGA.
+  answer ``shear``, its size the first member's κGA;
+* ``storey``: not the portal, the three-storey frame of ``problems/`` (nine members, 120
+  elements; sensors x and y at 0.33 and 0.71 of every member, no joint sensors) with one
+  of: a floor's end tied to its joint through a rotational spring of 0.3 to 4.6 times the
+  floor's EI/ℓ (the ``joint`` class's range), a mass of 0.1 to 0.6 of a floor's mass at
+  a floor's joint, or a base turning against a rotational spring of 0.35 to 7 times the
+  column's EI/ℓ (the ``support`` class's range); a structure the other classes never
+  show the tool.  A joint spring is right on its joint and floor (at a corner, where
+  two members meet, on either: one structure).
 
 Noise 1 to 2.5 times 0.3 % shape / 0.05 % frequency, stated (its true level) in half the
 cases.  The loop is the beam campaign's (``bench_diagnosis.follow``): ``diagnose``; while
@@ -98,13 +106,13 @@ from gfe_opt import diagnosis  # noqa: E402
 from gfe_opt.diagnosis import diagnose  # noqa: E402
 from gfe_opt.frame import frame_modes  # noqa: E402
 from gfe_opt.model import Effect  # noqa: E402
-from gfe_opt.problems import portal_frame  # noqa: E402
+from gfe_opt.problems import portal_frame, three_storey_frame  # noqa: E402
 from tests.frame_reference import ExactFrame, self_stress, taper_frame, zone_frame  # noqa: E402
 from tests.test_frame import deep_portal  # noqa: E402
 from tests.test_frame_diagnosis import NOISE, _braced_portal, _exact, _guess, _measured, _sensors  # noqa: E402
 
 CLASSES = ("none", "joint", "joints", "support", "crack", "mass", "material", "zone", "tension",
-           "lean", "ground", "deep", "taper")
+           "lean", "ground", "deep", "taper", "storey")
 POSITION_TOLERANCE = 0.02
 DETECTABLE = 2.0     # first chi2/n at the stated noise below which a change is noise
 
@@ -224,18 +232,69 @@ def make_case(seed: int, group: str) -> dict:
                    for i, t in zip(ids, forces)]
         answers = [{"name": "axial_load", "member": "brace",
                     "size": forces[ids.index("brace")]}]
+    elif group == "storey":
+        model, exact, bracket, answers = _storey(rng)
     else:
         raise ValueError(group)
     factor = float(rng.uniform(1.0, 2.5))
     noise = {k: v * factor for k, v in NOISE.items()}
     if group != "crack":
         guess = _guess(model, bracket)
-    measured = _measured(model, exact, guess, _sensors(model),
+    sensors = _member_sensors(model) if group == "storey" else _sensors(model)
+    measured = _measured(model, exact, guess, sensors,
                          int(rng.integers(2**31)), where, noise)
     stated = bool(rng.random() < 0.5)
     return {"name": f"{group}-{seed}", "group": group, "model": model, "measured": measured,
             "answers": answers, "noise_factor": factor, "stated": stated,
             "noise": noise if stated else {}}
+
+
+def _member_sensors(model):
+    """x and y at 0.33 and 0.71 of every member (the frame tests' sensors without their two
+    at the portal's named joints)."""
+    return [{"member": m.id, "position": round(t * model.member_length(m), 4),
+             "direction": d} for m in model.members for t in (0.33, 0.71) for d in ("x", "y")]
+
+
+def _storey(rng):
+    """The three-storey frame (a structure the portal's classes never showed the tool) with
+    one of: a loose joint (a floor's end tied to its joint through a rotational spring of
+    0.3-4.6 times the floor's EI/l, the portal's joint class's range), a mass at a joint
+    (0.1-0.6 of a floor's mass) or a base that gives (0.35-7 times the column's EI/l, the
+    portal's support class's range)."""
+    model = three_storey_frame()
+    ids = [m.id for m in model.members]
+    kind = str(rng.choice(["joint", "mass", "support"]))
+    if kind == "joint":
+        floor, side = int(rng.integers(1, 4)), str(rng.choice(["L", "R"]))
+        member = model.member(f"floor-{floor}")
+        k = _log_uniform(rng, 0.3, 4.6) * member.E * member.inertia \
+            / model.member_length(member)
+        node = f"{side}{floor}"
+        exact = _exact(model, [(node, ids.index(member.id), k)])
+        bracket = [Effect("joint_spring", {"node": node, "member": member.id, "stiffness": k})]
+        answers = [{"name": "joint_spring", "node": node, "member": member.id, "size": k}]
+    elif kind == "mass":
+        floor, side = int(rng.integers(1, 4)), str(rng.choice(["L", "R"]))
+        member = model.member(f"floor-{floor}")
+        node = f"{side}{floor}"
+        mass = float(rng.uniform(0.1, 0.6)) * member.rho * member.area \
+            * model.member_length(member)
+        base = _exact(model)
+        exact = ExactFrame(base.nodes, base.members, dict(model.supports), (),
+                           base.member_ids, (), [(node, mass)])
+        at = 0.0 if node == member.start else model.member_length(member)
+        bracket = [Effect("point_mass", {"member": member.id, "position": at, "mass": mass})]
+        answers = [{"name": "point_mass", "node": node, "size": mass}]
+    else:
+        node = str(rng.choice(["L0", "R0"]))
+        column = model.member("column-L1" if node == "L0" else "column-R1")
+        k = _log_uniform(rng, 0.35, 7.0) * column.E * column.inertia \
+            / model.member_length(column)
+        exact = _exact(model, ground_springs=[(node, 2, k)])
+        bracket = [Effect("support_spring", {"node": node, "stiffness": k})]
+        answers = [{"name": "support_spring", "node": node, "size": k}]
+    return model, exact, bracket, answers
 
 
 def _zone(model, rng):
@@ -285,7 +344,10 @@ def _matches(model, effect: Effect, answer: dict) -> bool:
     if effect.name != answer["name"]:
         return False
     if answer["name"] in ("joint_spring", "support_spring"):
-        return p.get("node") == answer["node"]
+        # at a joint of two members, either's end turning on the spring is one structure
+        meeting = sum(answer["node"] in (m.start, m.end) for m in model.members)
+        return p.get("node") == answer["node"] and (
+            meeting <= 2 or p.get("member") == answer.get("member", p.get("member")))
     if answer["name"] == "point_spring" and p.get("direction") != answer["direction"]:
         return False
     if answer["name"] in ("crack", "section_loss", "point_spring"):
