@@ -30,6 +30,8 @@ Model file (``kind = "frame"``; README "Plane frames")::
                           stiffness_ratio (EI), mass_ratio (ρA and EA)
                  effect = "shear": shear_rigidity (N; κGA of the first member, every
                           member's κGA its GA over the first's times it: Timoshenko members)
+                 effect = "member_shear": member, shear_rigidity (N; that member
+                          Timoshenko with its own κGA, beside a shear its κ not the others')
 
 Frames have modes (:func:`frame_modes`, ``gfe-opt modes``), are compared with tests
 (:mod:`gfe_opt.frame_data`), go through the beam's fits (:class:`FrameDiscretisation`:
@@ -51,7 +53,7 @@ from .errors import GfeInputError
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
                  "point_mass", "point_spring", "axial_stiffness", "material", "section_loss",
-                 "axial_load", "foundation", "shear", "stiffness_profile")
+                 "axial_load", "foundation", "shear", "stiffness_profile", "member_shear")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -358,6 +360,10 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
         no_unknown(raw, {"effect", "member", "stiffness"}, where, prefix)
         return _as_effect({"effect": name, "member": member_id, "stiffness": _number(
             raw, "stiffness", where, positive=True, prefix=prefix)})
+    if name == "member_shear":
+        no_unknown(raw, {"effect", "member", "shear_rigidity"}, where, prefix)
+        return _as_effect({"effect": name, "member": member_id, "shear_rigidity": _number(
+            raw, "shear_rigidity", where, positive=True, prefix=prefix)})
     if name == "axial_load":
         no_unknown(raw, {"effect", "member", "tension"}, where, prefix)
         return _as_effect({"effect": name, "member": member_id,
@@ -524,7 +530,8 @@ def _effect_key(effect) -> tuple | None:
         return None
     if e["effect"] in ("material", "shear"):
         return (e["effect"],)
-    if e["effect"] in ("axial_stiffness", "axial_load", "foundation", "stiffness_profile"):
+    if e["effect"] in ("axial_stiffness", "axial_load", "foundation", "stiffness_profile",
+                       "member_shear"):
         return (e["effect"], e["member"]) if "member" in e else None
     if "node" not in e:
         return None   # --add without a place: every place is tried
@@ -703,6 +710,7 @@ def _zoned_elements(zones, step: float, count: int) -> list[int]:
 #: the effects that change a member's elements (the others act at joints, supports and
 #: places: springs, masses, applied in :func:`frame_matrices`)
 _ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness", "axial_load", "foundation",
+                    "member_shear",
                     "stiffness_profile")
 
 
@@ -916,10 +924,20 @@ def shear_rigidity(model: FrameModel) -> float | None:
                  if e.name == "shear" and "shear_rigidity" in e.parameters), None)
 
 
+def has_shear(model: FrameModel) -> bool:
+    """Whether any member is Timoshenko (a ``shear`` or a ``member_shear``)."""
+    return any(e.name in ("shear", "member_shear") for e in model.effects)
+
+
 def member_shear_rigidity(model: FrameModel, member: Member) -> float | None:
-    """``member``'s κGA under a ``shear`` effect: its shear rigidity times the member's GA
-    over the first member's (G = E / (2 (1 + ν)): κ the same for every member), None
-    without one."""
+    """``member``'s κGA: a ``member_shear``'s on it, else under a ``shear`` effect its shear
+    rigidity times the member's GA over the first member's (G = E / (2 (1 + ν)): κ the
+    same for every member), None without either (Euler–Bernoulli)."""
+    own = next((float(e.parameters["shear_rigidity"]) for e in model.effects
+                if e.name == "member_shear" and e.parameters.get("member") == member.id
+                and "shear_rigidity" in e.parameters), None)
+    if own is not None:
+        return own
     value = shear_rigidity(model)
     if value is None:
         return None
@@ -1067,10 +1085,13 @@ class FrameDiscretisation:
                                                        * model.member_length(m) ** 4)
                                     for m in model.members)
         self._matrices = None
-        if shear_rigidity(model) is not None:
-            #: Timoshenko members: each element's g (a fit then differentiates the sensors'
-            #: reading too: it interpolates with the shear strains)
-            self.shear_g = np.concatenate([m.shear_g for m in member_elements(model)])
+        if has_shear(model):
+            #: Timoshenko members: each element's g, 0 on an Euler–Bernoulli member (a fit
+            #: then differentiates the sensors' reading too: it interpolates with the shear
+            #: strains)
+            self.shear_g = np.concatenate([
+                m.shear_g if m.shear_g is not None else np.zeros(len(m.axial))
+                for m in member_elements(model)])
 
     def global_matrices(self, params=None):
         """(K, M) over all DOFs, supports not applied (``params`` must be None: a frame's

@@ -39,8 +39,8 @@ from .frame import (
     FrameModel,
     frame_mesh,
     frame_modes,
+    has_shear,
     rotations,
-    shear_rigidity,
 )
 from .measured import ModeCounts, time_and_label
 
@@ -285,7 +285,7 @@ def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
 def with_shear(model: FrameModel, mesh: FrameMesh, sensors, C) -> sp.csr_matrix:
     """``C`` (:func:`build_observation`'s reading of ``sensors``) as Timoshenko members read
     them: plus :func:`shear_reading` under a ``shear`` effect; a copy either way."""
-    return C.copy() if shear_rigidity(model) is None else C + shear_reading(model, mesh, sensors)
+    return C + shear_reading(model, mesh, sensors) if has_shear(model) else C.copy()
 
 
 def shear_reading(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
@@ -306,6 +306,8 @@ def shear_reading(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
             continue   # a joint: read at the node, nothing interpolated
         k = index[s["member"]]
         member, g = model.members[k], members[k].shear_g
+        if g is None:
+            continue   # an Euler–Bernoulli member among Timoshenko ones (a member_shear)
         L = model.member_length(member) / member.elements
         j = min(int(s["position"] // L), member.elements - 1)
         H = el.hermite(s["position"] / L - j)

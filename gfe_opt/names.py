@@ -6,7 +6,8 @@ imported here, so ``gfe-opt --version``, ``--help`` and usage errors start in a 
 #: :data:`gfe_opt.effects.EFFECTS`)
 BUILTIN_EFFECTS = ("material", "crack", "section_loss", "shear", "axial_load", "foundation",
                    "support_spring", "support_translation", "point_spring", "point_mass",
-                   "stiffness_profile", "mass_profile", "joint_spring", "axial_stiffness")
+                   "stiffness_profile", "mass_profile", "joint_spring", "axial_stiffness",
+                   "member_shear")
 #: lowest MAC of a pair in ``compare``
 DEFAULT_MAC_THRESHOLD = 0.6
 #: shape noise that regularises the expansion in ``compare``

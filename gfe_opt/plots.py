@@ -587,7 +587,8 @@ FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "point_mass": ("s", "tab:purple"), "point_spring": ("^", "tab:green"),
                "axial_stiffness": (None, "tab:blue"),
                "axial_load": (None, "tab:cyan"), "foundation": (None, "tab:olive"),
-               "shear": ("*", "tab:pink"), "stiffness_profile": (None, "goldenrod")}
+               "shear": ("*", "tab:pink"), "stiffness_profile": (None, "goldenrod"),
+               "member_shear": (None, "tab:pink")}
 
 
 def frame_findings(members, marks, failing, title):

@@ -77,6 +77,7 @@ def _register_builtins():
         joint_spring,
         mass_profile,
         material,
+        member_shear,
         point_mass,
         point_spring,
         section_loss,
@@ -88,7 +89,8 @@ def _register_builtins():
 
     for module in (material, crack, section_loss, shear, axial_load, foundation,
                    support_spring, support_translation, point_spring, point_mass,
-                   stiffness_profile, mass_profile, joint_spring, axial_stiffness):
+                   stiffness_profile, mass_profile, joint_spring, axial_stiffness,
+                   member_shear):
         register_effect(module.EFFECT)
 
 
