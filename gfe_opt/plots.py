@@ -360,7 +360,8 @@ def frame_nodal_coefficients(members):
     value along it is named with that value."""
     from .realisation import uniform_term
 
-    fig = _figure(7.0, 5.8)
+    many = len(members) > 3   # the legend beside the panels, not over the curves
+    fig = _figure(9.5 if many else 7.0, 5.8)
     top, middle, bottom = fig.subplots(3, 1, sharex=True)
     from matplotlib import rcParams
 
@@ -378,7 +379,10 @@ def frame_nodal_coefficients(members):
                     color=colour)
     top.axhline(1.0, color="0.5", lw=0.8)
     top.set_ylabel("ratio to the model")
-    top.legend(fontsize=6, ncol=2)
+    if many:
+        fig.legend(*top.get_legend_handles_labels(), fontsize=6, loc="outside right upper")
+    else:
+        top.legend(fontsize=6, ncol=2)
     top.set_title("What each member node's updated equation says, in the member's axes:\n"
                   r"$(k\,w'')'' - T\,w'' + k_f\,w + m\,\ddot w = 0$ across it, "
                   r"$-(EA\,u')' + m\,\ddot u = 0$ along it", fontsize=9)
