@@ -236,6 +236,11 @@ def frame_parameterisation(model: FrameModel) -> FrameParameterisation:
                                  lengths=tuple(lengths), positions=tuple(positions))
 
 
+#: the residual weighting of a frame's generic update (:func:`gfe_opt.updating.update_generic`):
+#: the paper's rows; ``scripts/bench_frame_generic.py --weighting energy`` measures the other
+WEIGHTING = "rows"
+
+
 def update_frame_generic(model: FrameModel, measured, *, noise: float, **options):
     """The generic update (:func:`~gfe_opt.updating.update_generic`, ``expand``, the row
     weighting) of a frame's members; ``noise`` the relative shape noise."""
@@ -243,7 +248,7 @@ def update_frame_generic(model: FrameModel, measured, *, noise: float, **options
 
     disc = FrameGeneric(model)
     return update_generic(disc, measured, parameterisation=frame_parameterisation(model),
-                          noise=noise, weighting="rows", **options)
+                          noise=noise, weighting=WEIGHTING, **options)
 
 
 def member_ratios(result, axial: bool = False) -> dict:

@@ -41,7 +41,12 @@ def main():
     parser.add_argument("--seeds", default="100-111", help="first-last (inclusive)")
     parser.add_argument("--samples", type=int, default=realisation.BAND_SAMPLES)
     parser.add_argument("--no-floor", action="store_true")
+    parser.add_argument("--weighting", choices=("rows", "energy"), default="rows",
+                        help="the generic update's residual weighting (rows: the paper's)")
     args = parser.parse_args()
+    from gfe_opt import frame_generic
+
+    frame_generic.WEIGHTING = args.weighting
     first, last = (int(v) for v in args.seeds.split("-"))
     if args.no_floor:
         local = realisation._frame_change
