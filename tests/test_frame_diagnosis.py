@@ -271,6 +271,9 @@ def test_a_crack_near_a_column_base_is_found_on_that_column_at_its_place():
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
 
+# slow since stop 46 (11 s on a slow hour; the suite reached 11.5 min there): the frame
+# campaign's `lean` class draws 4 such cases a seed, every member, across it
+@pytest.mark.slow
 def test_a_column_leaning_on_a_wall_is_a_point_spring_there():
     """The left column held across (x) at 40 % of its height by a spring to ground of 30
     times its EI/L³ (a wall it touches, a brace to the next frame): the exact frame with the
