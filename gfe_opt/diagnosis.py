@@ -1774,8 +1774,8 @@ def _profile_start(model, measured, effect, noise):
     kind = effect_type(effect.name)
     member = effect.parameters.get("member")
     if model.kind == "frame" and member is None:
-        raise GfeInputError("--add", effect.name, "a stiffness_profile on a frame needs its "
-                            "member: --add stiffness_profile:member=ID")
+        raise GfeInputError("--add", effect.name, f"a {effect.name} on a frame needs its "
+                            f"member: --add {effect.name}:member=ID")
     if model.kind == "frame" and "x" in effect.parameters:   # ratios from 1
         x = effect.parameters["x"]
         return Effect(effect.name, {"member": member, "x": list(x), "ratio": [1.0] * len(x)})

@@ -53,7 +53,8 @@ from .errors import GfeInputError
 SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roller-y": (0,)}
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
                  "point_mass", "point_spring", "axial_stiffness", "material", "section_loss",
-                 "axial_load", "foundation", "shear", "stiffness_profile", "member_shear")
+                 "axial_load", "foundation", "shear", "stiffness_profile", "member_shear",
+                 "mass_profile")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -342,15 +343,15 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
         return _as_effect({"effect": name, "member": member_id, "ratio": ratio})
     if name == "section_loss":
         return _section_loss(model, member, raw, where, prefix)
-    if name == "stiffness_profile":   # EI(x) along the member, knots from its start
+    if name in ("stiffness_profile", "mass_profile"):   # EI(x) or ρA(x) along the member
         from .effects import effect_type
 
         no_unknown(raw, {"effect", "member", "x", "ratio"}, where, prefix)
         kind = effect_type(name)
         for key in ("x", "ratio"):
             if key not in raw:
-                raise GfeInputError(where, prefix + key, "missing (a stiffness_profile on "
-                                    "a frame needs member, x and ratio)")
+                raise GfeInputError(where, prefix + key, f"missing (a {name} on a frame "
+                                    "needs member, x and ratio)")
         x = kind.parameter("x").check(raw["x"], model, where, prefix + "x",
                                       length=model.member_length(member))
         ratio = kind.parameter("ratio").check(raw["ratio"], model, where, prefix + "ratio")
@@ -531,7 +532,7 @@ def _effect_key(effect) -> tuple | None:
     if e["effect"] in ("material", "shear"):
         return (e["effect"],)
     if e["effect"] in ("axial_stiffness", "axial_load", "foundation", "stiffness_profile",
-                       "member_shear"):
+                       "member_shear", "mass_profile"):
         return (e["effect"], e["member"]) if "member" in e else None
     if "node" not in e:
         return None   # --add without a place: every place is tried
@@ -710,8 +711,7 @@ def _zoned_elements(zones, step: float, count: int) -> list[int]:
 #: the effects that change a member's elements (the others act at joints, supports and
 #: places: springs, masses, applied in :func:`frame_matrices`)
 _ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness", "axial_load", "foundation",
-                    "member_shear",
-                    "stiffness_profile")
+                    "member_shear", "stiffness_profile", "mass_profile")
 
 
 @dataclass(frozen=True)
@@ -845,7 +845,12 @@ def _zone_mass(zones, rhoA: float, x0: float, L: float, x, w) -> np.ndarray:
     """(6, 6) local mass a member's section-loss zones add to the element [x0, x0 + L]:
     ρA (mass ratio − 1) ∫ NᵀN over the part covered (bar and beam shape functions, exact
     quadrature ``x``, ``w``)."""
-    c = rhoA * w * (_zone_factor(zones, 3)(x) - 1.0)
+    return _added_mass(rhoA * w * (_zone_factor(zones, 3)(x) - 1.0), x0, L, x)
+
+
+def _added_mass(c, x0: float, L: float, x) -> np.ndarray:
+    """(6, 6) local mass Σ c NᵀN of the element [x0, x0 + L] at points ``x`` with weights
+    ``c`` (the added ρA times the quadrature weight; bar and beam shape functions)."""
     s = (x - x0) / L
     added = np.zeros((6, 6))
     bar, beam = el.linear(s), el.hermite(s) * el.beam_dof_scaling(np.array([L]))[0]
@@ -902,6 +907,16 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     zones = _zones(model, member.id)
     for j, start, x, w in _zoned_quadrature(zones, L[0], n):
         local_m[j] += _zone_mass(zones, rhoA[j], start, L[0], x, w)
+    profile = next(((np.asarray(e["x"], float), np.asarray(e["ratio"], float))
+                    for e in model.raw_effects
+                    if e["effect"] == "mass_profile" and e["member"] == member.id), None)
+    if profile is not None:   # ρA × its piecewise-linear ratio on every element
+        for j in range(n):
+            start = j * L[0]
+            x, w = el.element_quadrature(start, start + L[0], tuple(
+                k for k in profile[0] if start < k < start + L[0]))
+            local_m[j] += _added_mass(rhoA[j] * w * (np.interp(x, *profile) - 1.0), start,
+                                      L[0], x)
     T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
     Tt = np.swapaxes(T, 1, 2)
     return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension, foundation, g)

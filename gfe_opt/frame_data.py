@@ -602,7 +602,8 @@ def _mark(model: FrameModel, name: str, params: dict):
     values = ", ".join(f"{k} {v:.3g}{unit(k)}" for k, v in params.items()
                        if k != "position" and isinstance(v, (int, float)))
     if isinstance(params.get("ratio"), (list, tuple)):   # a profile: EI × ratio at its knots
-        values = "EI × " + ", ".join(f"{r:.3g}" for r in params["ratio"]) + " at " + \
+        what = "ρA × " if name == "mass_profile" else "EI × "
+        values = what + ", ".join(f"{r:.3g}" for r in params["ratio"]) + " at " + \
             ", ".join(f"{x:.3g}" for x in params["x"]) + " m"
     line = None
     if "length" in params:   # a zone: drawn over its extent on its member

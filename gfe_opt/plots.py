@@ -592,7 +592,7 @@ FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "axial_stiffness": (None, "tab:blue"),
                "axial_load": (None, "tab:cyan"), "foundation": (None, "tab:olive"),
                "shear": ("*", "tab:pink"), "stiffness_profile": (None, "goldenrod"),
-               "member_shear": (None, "tab:pink")}
+               "member_shear": (None, "tab:pink"), "mass_profile": (None, "tab:purple")}
 
 
 def frame_findings(members, marks, failing, title):

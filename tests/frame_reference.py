@@ -375,13 +375,15 @@ def zone_frame(model, member_id, a, b, stiffness_ratio, area_ratio, ground_sprin
     return ExactFrame(nodes, members, dict(model.supports), (), names, ground_springs), where
 
 
-def taper_frame(model, member_id, end_ratio, segments=60):
+def taper_frame(model, member_id, end_ratio, segments=60, quantity="EI"):
     """The exact frame of ``model`` (geometry and sections) with member ``member_id``'s EI
     varying linearly from its own at the member's start to ``end_ratio`` times that at its
     end (ρA and EA as modelled: a web or flange tapered in depth, its mass kept), built as
     ``segments`` uniform exact members of the EI at their midpoints (a stepped taper, whose
     frequencies converge to the smooth one's as segments⁻²), and ``where``, which maps a
-    sensor of the model to the stepped frame's (parts ``<member>-0``, ``-1`` ...)."""
+    sensor of the model to the stepped frame's (parts ``<member>-0``, ``-1`` ...).  With
+    ``quantity="rhoA"`` its density varies so instead (ρA(x): a non-structural mass laid
+    along it unevenly), EI and EA as modelled."""
     member = next(m for m in model.members if m.id == member_id)
     (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
     L = math.hypot(x1 - x0, y1 - y0)
@@ -396,7 +398,10 @@ def taper_frame(model, member_id, end_ratio, segments=60):
             continue
         for i in range(segments):
             ratio = 1.0 + (end_ratio - 1.0) * (i + 0.5) / segments
-            members.append((ends[i], ends[i + 1], m.E, m.rho, m.area, m.inertia * ratio))
+            if quantity == "rhoA":
+                members.append((ends[i], ends[i + 1], m.E, m.rho * ratio, m.area, m.inertia))
+            else:
+                members.append((ends[i], ends[i + 1], m.E, m.rho, m.area, m.inertia * ratio))
             names.append(f"{m.id}-{i}")
     step = L / segments
 

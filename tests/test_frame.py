@@ -601,6 +601,8 @@ def _zone(**changes):
     (lambda d: d.update({"effects": [{"effect": "joint_spring", "member": "beam",
                                       "node": "A", "stiffness": 10.0}]}), "effects[0].node"),
     (lambda d: d.update({"effects": [{"effect": "mass_profile", "member": "beam"}]}),
+     "effects[0].x"),
+    (lambda d: d.update({"effects": [{"effect": "mass_loss", "member": "beam"}]}),
      "effects[0].effect"),
     (lambda d: d.update({"effects": [{"effect": "shear", "member": "beam",
                                       "shear_rigidity": 1e7}]}), "effects[0].member"),
@@ -1072,7 +1074,7 @@ def test_cli_update_on_a_frame(tmp_path):
     assert len(bad.stderr.strip().splitlines()) == 1
     profile = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
                               "mass_profile"], capture_output=True, text=True)
-    assert profile.returncode == 2 and "not fitted on frames yet" in profile.stderr
+    assert profile.returncode == 2 and "needs its member" in profile.stderr
     assert len(profile.stderr.strip().splitlines()) == 1
     twice = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data] + [
         "--add", "joint_spring:node=B,member=beam"] * 2, capture_output=True, text=True)

@@ -1,4 +1,5 @@
-"""``stiffness_profile`` on a frame member: EI(x) piecewise linear along it (issue 24:
+"""``stiffness_profile`` and ``mass_profile`` on a frame member: EI(x) or ρA(x) piecewise
+linear along it (issue 24:
 "every existing effect on any member it makes sense for").  The truth is the exact frame
 whose member tapers linearly, built as many uniform exact members (tests/frame_reference.py
 ``taper_frame``), not the package's elements."""
@@ -106,3 +107,56 @@ def test_a_tapered_column_is_diagnosed_as_its_profile_and_then_the_portal_agrees
         "stiffness_profile:member=left-column"], d.notes
     after = update(model, measured, d.add_arguments(), **NOISE)
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
+
+
+def _heavier(model, ratio):
+    L = model.member_length(model.member("beam"))
+    return [Effect("mass_profile", {"member": "beam", "x": [0.0, L], "ratio": [1.0, ratio]})]
+
+
+def test_a_mass_laid_unevenly_along_the_beam_converges_to_the_exact_frame_as_h4():
+    """``mass_profile`` on a frame member: the beam's ρA rising linearly to 2.5 times the
+    modelled at C (EI and EA as modelled), against the exact stepped frame of 120 segments
+    of that density (240 move the errors below by 1e-9).  The largest error of 6
+    frequencies falls as h⁴ (observed rates 3.87 and 3.97 between 5, 10 and 20 elements a
+    member), 3.6e-5 at 20; the portal without it is 30 % off."""
+    model = portal_frame()
+    exact, _ = taper_frame(model, "beam", 2.5, segments=120, quantity="rhoA")
+    effects = _heavier(model, 2.5)
+    fine = replace(model, members=tuple(replace(m, elements=80) for m in model.members))
+    f = np.array([exact.frequency_near(g, 1e-3)
+                  for g in frame_modes(fine.with_effects(effects), 6).frequencies_hz])
+    errors = []
+    for n in (5, 10, 20):
+        coarse = replace(model, members=tuple(replace(m, elements=n) for m in model.members))
+        errors.append(np.max(np.abs(frame_modes(coarse.with_effects(effects), 6)
+                                    .frequencies_hz / f - 1)))
+    rates = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(rates > 3.6), (errors, rates)
+    assert errors[-1] < 5e-5
+    assert np.max(np.abs(frame_modes(model, 6).frequencies_hz / f - 1)) > 0.05
+
+
+def test_update_adds_an_uneven_mass_on_the_beam_as_its_mass_profile():
+    """``update --add mass_profile:member=beam`` on the exact portal whose beam's ρA rises
+    linearly to 2.5 times at C, with noise: ρA(x) within 2 % of the truth at both ends and
+    the middle (0.25 % on seeds 4, 5, 6), χ²/n 12 000 to the noise; the effect is not one
+    ``diagnose`` tries on a frame unless named, and written to the frame file it reads
+    back."""
+    from gfe_opt.effects import candidate_names
+
+    model = portal_frame()
+    exact, where = taper_frame(model, "beam", 2.5, quantity="rhoA")
+    guess = frame_modes(model.with_effects(_heavier(model, 2.5)), 6).frequencies_hz
+    measured = _measured(model, exact, guess, _sensors(model), 4, where)
+    out = update(model, measured, ["mass_profile:member=beam"], **NOISE)
+    (profile,) = out.model.effects
+    x, ratio = profile.parameters["x"], profile.parameters["ratio"]
+    L = model.member_length(model.member("beam"))
+    assert profile.parameters["member"] == "beam" and x[0] == 0.0 and x[-1] == L
+    assert np.interp([0.0, L / 2, L], x, ratio) == pytest.approx([1.0, 1.75, 2.5], rel=0.02)
+    assert out.before.chi2_per_residual > 100 and out.after.chi2_per_residual < 2.0
+    assert "mass_profile" not in candidate_names("frame")
+    assert "mass_profile" in candidate_names("beam")
+    again = frame_from_dict(frame_to_dict(out.model), "written")
+    assert again.effects == out.model.effects

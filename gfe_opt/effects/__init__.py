@@ -65,7 +65,8 @@ def effect_type(name: str, where: str | None = None, field: str | None = "effect
 
 def candidate_names(kind: str) -> tuple:
     """Effects ``diagnose`` tries by default on a ``kind`` ("beam" or "bar")."""
-    return tuple(n for n, e in EFFECTS.items() if e.candidate and kind in e.kinds)
+    return tuple(n for n, e in EFFECTS.items() if e.candidate and kind in e.kinds
+                 and (kind != "frame" or e.frame_candidate))
 
 
 def _register_builtins():

@@ -273,6 +273,8 @@ class EffectType:
     local: bool = False
     #: proposed by ``diagnose`` unless the user chooses the candidates
     candidate: bool = True
+    #: tried by ``diagnose`` on a frame without being named (with :attr:`candidate`)
+    frame_candidate: bool = True
     #: parameters (contract) and those fitted (the others, e.g. a side, are fixed per fit)
     parameters: tuple = ()
     #: a uniform change every other candidate must beat (a uniform change is not a crack)

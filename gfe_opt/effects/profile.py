@@ -52,7 +52,25 @@ class ProfileEffect(EffectType):
         return None
 
     def starts(self, model, hint):
+        """Every knot count (on a frame: along each member)."""
+        if model.kind == "frame":
+            return [{"member": m.id, "x": [float(v) for v in np.linspace(
+                0.0, model.member_length(m), k)]} for m in model.members for k in KNOT_COUNTS]
         return [{"x": list(np.linspace(0.0, model.length, k))} for k in KNOT_COUNTS]
+
+    def fixed_keys(self, model=None) -> tuple:
+        """The knots are chosen (a frame: with the member)."""
+        if model is not None and model.kind == "frame":
+            return ("member", "x")
+        return super().fixed_keys(model)
+
+    def frame_placeholders(self, model, params):
+        known = {m.id: m for m in model.members}
+        if params["member"] not in known:   # the frame file's rule says which
+            return {"x": [0.0, 1.0], "ratio": [1.0, 1.0]}
+        length = model.member_length(known[params["member"]])
+        x = params.get("x", [0.0, length])
+        return {"x": x, "ratio": [1.0] * (len(x) if isinstance(x, (list, tuple)) else 2)}
 
     def position(self, params):
         return None
