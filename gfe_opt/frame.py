@@ -32,6 +32,10 @@ Model file (``kind = "frame"``; README "Plane frames")::
                           member's κGA its GA over the first's times it: Timoshenko members)
                  effect = "member_shear": member, shear_rigidity (N; that member
                           Timoshenko with its own κGA, beside a shear its κ not the others')
+                 effect = "axial_load": member, tension (N);  "foundation": member,
+                          stiffness (N/m²)
+                 effect = "stiffness_profile" | "mass_profile": member, x (knots, m from
+                          its start node), ratio (EI or ρA over the member's at each)
 
 Frames have modes (:func:`frame_modes`, ``gfe-opt modes``), are compared with tests
 (:mod:`gfe_opt.frame_data`), go through the beam's fits (:class:`FrameDiscretisation`:

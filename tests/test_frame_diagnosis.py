@@ -590,7 +590,9 @@ def test_unstated_noise_on_a_frame_needs_white_components_and_frequencies_at_a_t
 
 @pytest.mark.parametrize("seed, mass, factor, alike", [
     (26, 0.1087, 2.3, True), pytest.param(21, 0.1087, 2.3, True, marks=pytest.mark.slow),
-    (3, 0.15, 1.0, False)])
+    # slow since stop 46 (the suite reached 11 min on slow hours): the frame campaign's
+    # `mass` class draws 4 corner masses a seed, most of them told apart
+    pytest.param(3, 0.15, 1.0, False, marks=pytest.mark.slow)])
 def test_a_mass_at_a_corner_of_the_symmetric_portal_names_the_corner_it_cannot_tell_apart(
         seed, mass, factor, alike):
     """The portal is symmetric: a mass at joint C and one at joint B give the same
