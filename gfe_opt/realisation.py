@@ -169,9 +169,9 @@ def _compare_rows(new, old, length: float, significance: float) -> list[Realisat
     c4 = np.array([e.stiffness[4] for e in new])
     c4_old = np.array([e.stiffness[4] for e in old])
     k0 = float(np.mean(c4_old))
-    if len(x) >= 3:
+    if len(x) >= 2:
         kpp = np.gradient(np.gradient(c4, x), x) - np.gradient(np.gradient(c4_old, x), x)
-    else:
+    else:   # one interior node (a frame member of two elements): no k'' to read
         kpp = np.zeros(len(x))
     out = []
     for i, (a, b) in enumerate(zip(new, old)):
@@ -235,7 +235,7 @@ class MemberRealisation:
     length: float
     rows: tuple
     axial_ratio: np.ndarray
-    bending_rigidity: float   # the model's EI along it (mean of its 4th-derivative coefficients)
+    bending_rigidity: float   # the model's EI of the member
 
     @property
     def euler_load(self) -> float:
@@ -284,14 +284,14 @@ def realise_members(disc, initial, significance: float = 1e-3) -> list[MemberRea
     """:func:`realise` on a frame, member by member in each member's axes (its length the
     scale of the terms' significance)."""
     new, old = member_equations(disc), member_equations(initial)
+    model = initial.model
     out = []
     for member in disc.model.members:
         (rows, u2), (rows0, u20) = new[member.id], old[member.id]
         length = disc.model.member_length(member)
-        out.append(MemberRealisation(member.id, member.start, length,
-                                     tuple(_compare_rows(rows, rows0, length, significance)),
-                                     u2 / u20,
-                                     float(np.mean([r.stiffness[4] for r in rows0]))))
+        read = _compare_rows(rows, rows0, length, significance) if rows else []
+        out.append(MemberRealisation(member.id, member.start, length, tuple(read), u2 / u20,
+                                     model.stiffness_factor * member.E * member.inertia))
     return out
 
 
@@ -324,6 +324,8 @@ def uniform_term(values) -> float:
     """The median of a term that is present along the whole beam with one sign and a small
     spread (80 % of the nodes, interquartile range below half the median), else 0."""
     v = np.asarray(values, float)
+    if v.size == 0:   # no interior node (a frame member of one element)
+        return 0.0
     med = float(np.median(v))
     if med == 0.0 or np.mean(np.sign(v) == np.sign(med)) < 0.8:
         return 0.0

@@ -256,3 +256,22 @@ def test_the_softer_beams_nodal_equations_say_so_on_the_beam(seed):
         medians[m.member] = float(np.median(k))
     assert min(medians, key=medians.get) == "beam", medians
     assert medians["beam"] == pytest.approx(0.9, abs=0.03)
+
+
+def test_a_member_of_one_element_has_no_nodal_equation_and_breaks_nothing():
+    """A brace meshed as one element has no interior node: its reading is empty (no k'' of
+    one or two nodes is made up either) and the figure draws the other members."""
+    from gfe_opt.plots import frame_nodal_coefficients
+    from gfe_opt.realisation import realise_members
+
+    model = loose_brace(1.0)[0]
+    for n, count in ((1, 0), (2, 1)):
+        meshed = replace(model, members=tuple(replace(m, elements=n) if m.id == "brace"
+                                              else m for m in model.members))
+        read = {m.member: m for m in realise_members(FrameGeneric(meshed),
+                                                     FrameDiscretisation(meshed))}
+        assert len(read["brace"].rows) == len(read["brace"].axial_ratio) == count
+        assert all(abs(r.k_ratio - 1) < 1e-9 and r.tension == 0.0 for r in read["brace"].rows)
+        fig = frame_nodal_coefficients(list(read.values()))
+        drawn = {ln.get_label() for ln in fig.axes[0].get_lines()}
+        assert "beam (from B): $k/k_0$" in drawn
