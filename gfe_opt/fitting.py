@@ -57,6 +57,7 @@ from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, observation, sensor_matrix
 from .modal import condensed, discretisation_modes, rigid_body_count
 from .model import Effect, Model
+from .screening import screened_chi2
 
 DEFAULT_FREQ_NOISE = names.DEFAULT_FREQ_NOISE
 DEFAULT_SHAPE_NOISE = names.DEFAULT_FIT_SHAPE_NOISE
@@ -168,11 +169,22 @@ def evaluate(model, measured, noise: Noise, C=None) -> Point | None:
     if the solve fails."""
     try:
         disc = discretise(model)
-        n_model = min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(model, disc))
+        n_model = model_modes(model, disc, measured)
         K, M = disc.global_matrices()
         modes = discretisation_modes(disc, n_model, matrices=(K, M))
     except (GfeSolverError, ValueError, np.linalg.LinAlgError):
         return None
+    return point_of(disc, K, M, modes, measured, noise, C)
+
+
+def model_modes(model, disc, measured) -> int:
+    """How many model modes a residual pairs the measured ones with: four more than were
+    measured, and the rigid-body ones."""
+    return min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(model, disc))
+
+
+def point_of(disc, K, M, modes, measured, noise: Noise, C=None) -> Point:
+    """The :class:`Point` of :func:`evaluate` from the model's modes, however solved."""
     if measured.frequency_only:
         pairs = pair_by_frequency(measured.frequencies_hz, modes.frequencies_hz)
         rows = np.array([t for t, _ in pairs], dtype=int)
@@ -442,6 +454,9 @@ def jsonable(params: dict) -> dict:
 #: the modal solves: the old path, kept for scripts/bench.py --parts fits, which sets it for
 #: every process through the environment variable GFE_OPT_JACOBIAN)
 JACOBIAN = os.environ.get("GFE_OPT_JACOBIAN", "analytic")
+#: grids screened in bulk (:mod:`gfe_opt.screening`) where their points differ locally;
+#: ``GFE_OPT_SCREEN=0`` solves every grid point (``scripts/bench.py`` compares both)
+SCREEN = os.environ.get("GFE_OPT_SCREEN", "1") != "0"
 if JACOBIAN not in ("analytic", "difference"):
     raise GfeInputError("GFE_OPT_JACOBIAN", None, f"must be 'analytic' or 'difference', got "
                         f"{JACOBIAN!r}")
@@ -624,8 +639,15 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
              for slot in slots]
     starts, informed = [], []
     variants = [grids] + [grids[:-1] + [grid_of(slots[-1], alt)] for alt in alternatives]
+    # a grid screened in bulk where its points differ on one member or at one node of a
+    # frame (a beam's places span the whole beam: nothing to gain, :mod:`.screening`)
+    placed = bool(slots) and any(k in slots[-1].fixed for k in ("member", "node"))
+
+    def bulk(zs, null):
+        return screened_chi2(residual, chi2, zs, null) if SCREEN and placed else None
+
     for grid in variants:
-        start, guess = _grid_start(chi2, grid, nulls)
+        start, guess = _grid_start(chi2, grid, nulls, bulk)
         starts.append(np.clip(start, lower, upper))
         if guess is not None:
             informed.append(problem.untied(np.clip(guess, lower, upper)))
@@ -1250,7 +1272,7 @@ def _value(start: dict, v) -> float:
     return start[v.key] if v.index is None else start[v.key][v.index]
 
 
-def _grid_start(chi2, grids, nulls=None):
+def _grid_start(chi2, grids, nulls=None, bulk=None):
     """Best point of a coarse grid: each slot's grid (the product of its variables' grids)
     searched with the other slots at their current point.  Of the points where a slot's
     effect vanishes (``nulls``: per slot, per variable, :func:`_null_of`) only the first is
@@ -1266,14 +1288,19 @@ def _grid_start(chi2, grids, nulls=None):
             continue
         points = np.array(np.meshgrid(*slot, indexing="ij")).reshape(len(slot), -1).T
         null = _null_points(points, nulls[i] if nulls else None)
-        values = []
-        for j, point in enumerate(points):
-            if null[j] and null[:j].any():
-                values.append(np.inf)   # the first vanished point stands for them all
-                continue
+        # the first vanished point stands for them all
+        solved = [j for j in range(len(points)) if not (null[j] and null[:j].any())]
+        trials = []
+        for j in solved:
             trial = list(current)
-            trial[i] = point
-            values.append(chi2(np.concatenate(trial)))
+            trial[i] = points[j]
+            trials.append(np.concatenate(trial))
+        found = bulk(trials, null[solved]) if bulk is not None else None
+        if found is None:
+            found = [chi2(z) for z in trials]
+        values = [np.inf] * len(points)
+        for j, value in zip(solved, found):
+            values[j] = value
         best = lowest(values)
         current[i] = points[best]
         informed = None

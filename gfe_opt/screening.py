@@ -1,0 +1,160 @@
+r"""A fit's grid of starting points screened in bulk (issue 22, item 3).
+
+A fit starts from the best point of a coarse grid (:func:`gfe_opt.fitting._grid_start`):
+on a frame, an effect on one member at 19 places and several sizes, each point a full modal
+solve (5 ms on the three-storey frame's 351 free DOFs).  The points differ from each other
+only on the DOFs of that member, so one basis serves them all (Rayleigh–Ritz): the first
+point's modes, :data:`EXTRA_MODES` more than the residual pairs, and the static response
+:math:`(K_0 + s M_0)^{-1} E_S` to a unit load at each DOF ``S`` where any point's K or M
+differs from the first's (:math:`s` the model's eigenvalue scale: positive definite also
+when the structure is free).  The exact modes of a point satisfy
+:math:`(K_0 - λM_0)φ = -(ΔK - λΔM)φ`, a load on ``S``; the basis holds its static part
+exactly and its dynamic part through the modes.  Measured on the portal's and the
+three-storey frame's grids (crack, point mass, point spring, section loss, axial load,
+joint spring): χ² within 1e-9 (median) and 2e-5 (worst) of the exact solve's, at a third
+to a quarter of its cost.
+
+The screened values only choose which points are solved exactly: every point whose
+screened χ² lies within :data:`MARGIN` of the lowest, and the :data:`SHORTLIST` lowest
+(of all points, and of those where the effect is present: the grid's guess of a place).
+The grid's choice is then the exact solve's whenever the screen errs by less than half the
+margin, which is checked on the points solved exactly: a larger error there, or a point
+the reduced solve cannot take, and every point is solved exactly.  Where the points differ
+on more than :data:`LOCAL_FRACTION` of the free DOFs (a beam's grid spans the whole beam;
+a uniform change of E touches everything) the basis would be the whole model: the grid is
+solved point by point as before.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .assembly import discretise
+from .errors import GfeSolverError
+from .modal import Modes, condensed, solve_modes
+
+#: the basis stands in for the exact solve only where the points differ on at most this
+#: fraction of the free DOFs
+LOCAL_FRACTION = 0.5
+#: points whose screened χ² lies within this fraction of the lowest are solved exactly
+#: (100 times the worst screening error measured: the module docstring)
+MARGIN = 1e-3
+#: and at least this many of the lowest
+SHORTLIST = 3
+#: modes of the first point in the basis beyond those the residual pairs
+EXTRA_MODES = 10
+#: fewer points than this are solved one by one (the basis costs about as much as 3 solves)
+MIN_POINTS = 8
+#: screens run and screens that fell back to solving every point (tests and benchmarks
+#: read them)
+TALLY = {"screened": 0, "fallback": 0}
+
+
+def screened_chi2(residual, chi2, zs, null) -> list[float] | None:
+    """χ² at each of the points ``zs`` of one grid (``null[j]``: the effect vanishes at
+    point j; of such points the grid passes only one), exact (``chi2(z)``, the fit's own) at the points the screen keeps (module docstring) and screened at the
+    others; None when the grid is to be solved point by point."""
+    if len(zs) < MIN_POINTS:
+        return None
+    from .fitting import FAILED_RESIDUAL, model_modes, point_of
+
+    measured, noise = residual.measured, residual.noise
+    try:
+        models = [residual.model_at(z) for z in zs]
+        if condensed(models[0]):
+            return None
+        discs = [discretise(m) for m in models]
+        matrices = [d.global_matrices() for d in discs]
+    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+        return None
+    d0, (K0, M0) = discs[0], matrices[0]
+    free = d0.free
+    if any(K.shape != K0.shape or not np.array_equal(d.free, free)
+           for d, (K, _) in zip(discs, matrices)):
+        return None   # the mesh itself differs from point to point (a released joint)
+    touched = np.zeros(K0.shape[0], dtype=bool)
+    for K, M in matrices[1:]:
+        for D in (sp.coo_matrix(K - K0), sp.coo_matrix(M - M0)):
+            touched[D.row[D.data != 0]] = True
+    local = np.flatnonzero(touched[free])
+    if local.size > LOCAL_FRACTION * free.size:
+        return None
+    try:
+        n_model = model_modes(models[0], d0, measured)
+        n_basis = min(n_model + EXTRA_MODES, free.size - 1)
+        first = solve_modes(K0, M0, n_basis, d0.constrained, d0.eigenvalue_scale,
+                            dense=getattr(d0, "dense_solve", None))
+        Kf = sp.csc_matrix(K0)[free][:, free]
+        Mf = sp.csc_matrix(M0)[free][:, free]
+        loads = np.zeros((free.size, local.size))
+        loads[local, np.arange(local.size)] = 1.0
+        static = spla.splu(sp.csc_matrix(Kf + d0.eigenvalue_scale * Mf)).solve(loads) \
+            if local.size else np.zeros((free.size, 0))
+        T = np.zeros((K0.shape[0], n_basis + local.size))   # zero at the constrained DOFs
+        T[free] = np.linalg.qr(np.hstack([first.shapes[free], static]))[0]
+    except (GfeSolverError, RuntimeError, ValueError, np.linalg.LinAlgError):
+        return None
+    screened = []
+    for model, disc, (K, M) in zip(models, discs, matrices):
+        try:
+            n = model_modes(model, disc, measured)
+            if n > T.shape[1]:
+                raise ValueError("more modes than the basis holds")
+            modes = _reduced_modes(K, M, T, n, disc.eigenvalue_scale)
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                r = point_of(disc, K, M, modes, measured, noise, residual.C).r
+            screened.append(float(np.sum(r ** 2)))
+        except (GfeSolverError, ValueError, FloatingPointError, np.linalg.LinAlgError):
+            screened.append(FAILED_RESIDUAL**2)
+    TALLY["screened"] += 1
+    values = np.array(screened)
+    present = ~np.asarray(null, dtype=bool)
+    keep = _shortlist(values, np.ones(values.size, dtype=bool)) | _shortlist(values, present)
+    keep |= values >= FAILED_RESIDUAL**2   # what the screen could not solve is solved exactly
+    out = list(values)
+    worst = 0.0
+    for j in np.flatnonzero(keep):
+        exact = chi2(zs[j])
+        if np.isfinite(exact) and exact < FAILED_RESIDUAL**2:
+            worst = max(worst, abs(values[j] - exact) / max(exact, 1e-300))
+        elif values[j] < FAILED_RESIDUAL**2:
+            worst = np.inf   # solved by the screen, not exactly
+        out[j] = exact
+    if worst > MARGIN / 4:
+        TALLY["fallback"] += 1
+        return None
+    return out
+
+
+def _shortlist(values, among) -> np.ndarray:
+    """Of the points ``among``, those within :data:`MARGIN` of their lowest screened χ²
+    and the :data:`SHORTLIST` lowest."""
+    keep = np.zeros(values.size, dtype=bool)
+    index = np.flatnonzero(among)
+    if index.size == 0:
+        return keep
+    v = values[index]
+    keep[index[v <= np.min(v) * (1.0 + MARGIN)]] = True
+    keep[index[np.argsort(v, kind="stable")[:SHORTLIST]]] = True
+    return keep
+
+
+def _reduced_modes(K, M, T, n_modes, eigenvalue_scale) -> Modes:
+    """The ``n_modes`` lowest modes of (K, M) in the basis ``T`` (zero at the constrained
+    DOFs), mass normalised (by the reduced solve), each signed as
+    :func:`~gfe_opt.modal.solve_modes` signs them."""
+    from .modal import peak_rows
+
+    Kr, Mr = T.T @ (K @ T), T.T @ (M @ T)
+    lam, q = sla.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T),
+                      subset_by_index=[0, n_modes - 1])
+    roundoff = max(1e-9 * eigenvalue_scale, 1e-8 * float(np.max(np.abs(lam))))
+    lam = np.where(np.abs(lam) < roundoff, 0.0, lam)
+    if np.any(lam < 0):
+        raise GfeSolverError("negative eigenvalue in the screened solve")
+    shapes = T @ q
+    shapes *= np.sign(shapes[peak_rows(shapes), np.arange(n_modes)])
+    return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=shapes)
