@@ -55,11 +55,40 @@ TALLY = {"screened": 0, "fallback": 0}
 
 def screened_chi2(residual, chi2, zs, null) -> list[float] | None:
     """χ² at each of the points ``zs`` of one grid (``null[j]``: the effect vanishes at
-    point j; of such points the grid passes only one), exact (``chi2(z)``, the fit's own) at the points the screen keeps (module docstring) and screened at the
-    others; None when the grid is to be solved point by point."""
+    point j; of such points the grid passes only one): exact (``chi2(z)``, the fit's own)
+    at the points the screen keeps (module docstring), screened at the others; None when
+    the grid is to be solved point by point."""
     if len(zs) < MIN_POINTS:
         return None
-    from .fitting import FAILED_RESIDUAL, model_modes, point_of
+    from .fitting import FAILED_RESIDUAL
+
+    values = screen(residual, zs)
+    if values is None:
+        return None
+    TALLY["screened"] += 1
+    present = ~np.asarray(null, dtype=bool)
+    keep = _shortlist(values, np.ones(values.size, dtype=bool)) | _shortlist(values, present)
+    keep |= values >= FAILED_RESIDUAL**2   # what the screen could not solve is solved exactly
+    out = list(values)
+    worst = 0.0
+    for j in np.flatnonzero(keep):
+        exact = chi2(zs[j])
+        if np.isfinite(exact) and exact < FAILED_RESIDUAL**2:
+            worst = max(worst, abs(values[j] - exact) / max(exact, 1e-300))
+        elif values[j] < FAILED_RESIDUAL**2:
+            worst = np.inf   # solved by the screen, not exactly
+        out[j] = exact
+    if worst > MARGIN / 4:
+        TALLY["fallback"] += 1
+        return None
+    return out
+
+
+def screen(residual, zs) -> np.ndarray | None:
+    """The screened χ² of the points ``zs`` (:data:`FAILED_RESIDUAL`² where the reduced
+    solve fails), or None where the grid's points do not differ locally or the basis
+    cannot be built."""
+    from .fitting import _TRIAL_ERRORS, FAILED_RESIDUAL, model_modes, point_of
 
     measured, noise = residual.measured, residual.noise
     try:
@@ -68,7 +97,7 @@ def screened_chi2(residual, chi2, zs, null) -> list[float] | None:
             return None
         discs = [discretise(m) for m in models]
         matrices = [d.global_matrices() for d in discs]
-    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+    except _TRIAL_ERRORS:
         return None
     d0, (K0, M0) = discs[0], matrices[0]
     free = d0.free
@@ -95,7 +124,7 @@ def screened_chi2(residual, chi2, zs, null) -> list[float] | None:
             if local.size else np.zeros((free.size, 0))
         T = np.zeros((K0.shape[0], n_basis + local.size))   # zero at the constrained DOFs
         T[free] = np.linalg.qr(np.hstack([first.shapes[free], static]))[0]
-    except (GfeSolverError, RuntimeError, ValueError, np.linalg.LinAlgError):
+    except (*_TRIAL_ERRORS, RuntimeError):
         return None
     screened = []
     for model, disc, (K, M) in zip(models, discs, matrices):
@@ -107,26 +136,9 @@ def screened_chi2(residual, chi2, zs, null) -> list[float] | None:
             with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
                 r = point_of(disc, K, M, modes, measured, noise, residual.C).r
             screened.append(float(np.sum(r ** 2)))
-        except (GfeSolverError, ValueError, FloatingPointError, np.linalg.LinAlgError):
+        except _TRIAL_ERRORS:
             screened.append(FAILED_RESIDUAL**2)
-    TALLY["screened"] += 1
-    values = np.array(screened)
-    present = ~np.asarray(null, dtype=bool)
-    keep = _shortlist(values, np.ones(values.size, dtype=bool)) | _shortlist(values, present)
-    keep |= values >= FAILED_RESIDUAL**2   # what the screen could not solve is solved exactly
-    out = list(values)
-    worst = 0.0
-    for j in np.flatnonzero(keep):
-        exact = chi2(zs[j])
-        if np.isfinite(exact) and exact < FAILED_RESIDUAL**2:
-            worst = max(worst, abs(values[j] - exact) / max(exact, 1e-300))
-        elif values[j] < FAILED_RESIDUAL**2:
-            worst = np.inf   # solved by the screen, not exactly
-        out[j] = exact
-    if worst > MARGIN / 4:
-        TALLY["fallback"] += 1
-        return None
-    return out
+    return np.array(screened)
 
 
 def _shortlist(values, among) -> np.ndarray:

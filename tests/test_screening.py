@@ -1,0 +1,103 @@
+"""Grid starts screened in bulk (gfe_opt.screening): the reduced solve's χ² against the
+exact solve's, and fits that end exactly where the point-by-point grid ends them."""
+
+import numpy as np
+import pytest
+
+from gfe_opt import fitting, screening
+from gfe_opt.frame_data import load_frame_measured
+from gfe_opt.model import Effect, load_model
+from gfe_opt.problems import portal_frame, problem_file
+from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+
+NOISE = fitting.noise_of(0.0005, 0.003)
+
+
+@pytest.fixture(scope="module")
+def portal():
+    model = portal_frame()
+    return model, load_frame_measured(problem_file("portal-frame-semirigid.json"), model)
+
+
+def _grid(problem):
+    """The added effect's grid points (full z vectors) as the fit searches them."""
+    slot = problem.slots[-1]
+    grid = [fitting._with_null(slot.effect, v, problem.base) for v in slot.variables]
+    points = np.array(np.meshgrid(*grid, indexing="ij")).reshape(len(grid), -1).T
+    return [np.clip(p, problem.lower, problem.upper) for p in points]
+
+
+@pytest.mark.parametrize("name,place", [("crack", {"member": "beam"}),
+                                        ("point_mass", {"member": "left-column"}),
+                                        ("section_loss", {"member": "right-column"})])
+def test_screened_chi2_is_the_exact_one_to_1e_6(portal, name, place):
+    """The screen's χ² on a member's grid agrees with the full modal solve to 1e-6
+    relative (the static response at the member's DOFs completes the first point's
+    modes)."""
+    model, measured = portal
+    problem = fitting.fit_problem(model, measured, [Effect(name, place)], noise=NOISE)
+    zs = _grid(problem)
+
+    def chi2(z):
+        return float(np.sum(problem.residual(z) ** 2))
+
+
+    exact = np.array([chi2(z) for z in zs])
+    screened = screening.screen(problem.residual, zs)
+    assert len(zs) >= 57
+    assert np.max(np.abs(screened / exact - 1)) < 1e-6
+    assert np.argmin(screened) == np.argmin(exact)
+
+
+def _same(a, b):
+    assert a.misfit.chi2 == b.misfit.chi2
+    assert a.status == b.status
+    assert [e.parameters for e in a.effects] == [e.parameters for e in b.effects]
+
+
+@pytest.mark.parametrize("name,place", [("crack", {"member": "beam"}),
+                                        ("point_spring", {"member": "left-column",
+                                                          "direction": "x"})])
+def test_screened_fit_ends_where_the_point_by_point_fit_ends(portal, monkeypatch, name,
+                                                             place):
+    """The screen only chooses which grid points are solved exactly: the fit's end is the
+    same to the last bit as with every point solved, in fewer full solves."""
+    model, measured = portal
+    monkeypatch.setattr(fitting, "SCREEN", False)
+    plain = fitting.fit_effects(model, measured, [Effect(name, place)], noise=NOISE)
+    monkeypatch.setattr(fitting, "SCREEN", True)
+    before = dict(screening.TALLY)
+    screened = fitting.fit_effects(model, measured, [Effect(name, place)], noise=NOISE)
+    assert screening.TALLY["screened"] > before["screened"]
+    assert screening.TALLY["fallback"] == before["fallback"]
+    _same(plain, screened)
+    assert screened.evaluations < plain.evaluations / 2
+
+
+def test_a_screen_that_errs_beyond_its_margin_solves_every_point(portal, monkeypatch):
+    """An error above a quarter of the margin on the points solved exactly (here a margin
+    of 1e-14, below the screen's 1e-9) and the whole grid is solved point by point: the
+    same end again."""
+    model, measured = portal
+    adding = [Effect("crack", {"member": "left-column"})]
+    monkeypatch.setattr(fitting, "SCREEN", False)
+    plain = fitting.fit_effects(model, measured, adding, noise=NOISE)
+    monkeypatch.setattr(fitting, "SCREEN", True)
+    monkeypatch.setattr(screening, "MARGIN", 1e-14)
+    before = dict(screening.TALLY)
+    again = fitting.fit_effects(model, measured, adding, noise=NOISE)
+    assert screening.TALLY["fallback"] > before["fallback"]
+    _same(plain, again)
+    assert again.evaluations >= plain.evaluations
+
+
+def test_a_beam_grid_is_solved_point_by_point():
+    """A beam's places span the whole beam: no screen (it would gain nothing)."""
+    model = load_model(problem_file("ss-steel-beam.toml"))
+    truth = model.with_effects([Effect("crack", {"position": 0.3, "depth_ratio": 0.4})])
+    measured = synthetic_measurement(truth, 4, interior_sensors(model.length, 15),
+                                     shape_noise=0.003, freq_noise=0.0005, seed=5)
+    before = dict(screening.TALLY)
+    fit = fitting.fit_effects(model, measured, [Effect("crack", {})], noise=NOISE)
+    assert screening.TALLY == before
+    assert fit.success and abs(fit.parameters["position"] - 0.3) < 0.01
