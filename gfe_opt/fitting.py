@@ -639,12 +639,8 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
              for slot in slots]
     starts, informed = [], []
     variants = [grids] + [grids[:-1] + [grid_of(slots[-1], alt)] for alt in alternatives]
-    # a grid screened in bulk where its points differ on one member or at one node of a
-    # frame (a beam's places span the whole beam: nothing to gain, :mod:`.screening`)
-    placed = bool(slots) and any(k in slots[-1].fixed for k in ("member", "node"))
-
-    def bulk(zs, null):
-        return screened_chi2(residual, chi2, zs, null) if SCREEN and placed else None
+    def bulk(zs, null):   # grids screened in bulk (:mod:`.screening`)
+        return screened_chi2(residual, chi2, zs, null) if SCREEN else None
 
     for grid in variants:
         start, guess = _grid_start(chi2, grid, nulls, bulk)
