@@ -356,7 +356,7 @@ class Fit:
     n_params: int
     status: str
     success: bool
-    evaluations: int
+    evaluations: int   # full residual evaluations (grid points the screen took not counted)
     significant: bool = False
     #: lowers χ² by more than its threshold alone, its size's σ aside: may lead a pair
     #: when a uniform change fits best alone (set by the diagnosis)
