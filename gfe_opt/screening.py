@@ -13,8 +13,8 @@ when the structure is free).  The exact modes of a point satisfy
 exactly and its dynamic part through the modes.  One basis serves the whole grid where the
 points together differ on at most :data:`LOCAL_FRACTION` of the free DOFs (a frame
 member), else one each set of DOFs (a place along a beam; points of one place share it);
-where a single point differs on more (a uniform change of E), the grid is solved point by
-point as before.  Measured on the portal's and the three-storey frame's grids (crack, point
+where a basis would hold more than that fraction (a uniform change of E; a model of a few
+elements, whose basis would be the model), the grid is solved point by point as before.  Measured on the portal's and the three-storey frame's grids (crack, point
 mass, point spring, section loss, axial load, joint spring): χ² within 1e-9 (median) and
 2e-5 (worst, relative) of the exact solve's; on the 46-element demo beam's (crack, point
 mass and spring, section loss, support spring) within 1e-8 and 1e-7, and on its support
@@ -42,8 +42,9 @@ from .assembly import discretise
 from .errors import GfeSolverError
 from .modal import Modes, condensed, solve_modes
 
-#: the basis stands in for the exact solve only where the points differ on at most this
-#: fraction of the free DOFs
+#: the screen's basis (the first point's modes and the static responses) holds at most this
+#: fraction of the free DOFs, else the points are solved one by one (a small model: its
+#: solve costs what a basis would; a uniform change touches every DOF)
 LOCAL_FRACTION = 0.5
 #: points whose screened χ² lies within this fraction of the lowest are solved exactly
 #: (100 times the worst screening error measured: the module docstring)
@@ -81,10 +82,10 @@ def screened_chi2(residual, chi2, zs, null) -> list[float] | None:
     worst = 0.0
     for j in np.flatnonzero(keep):
         exact = chi2(zs[j])
-        if np.isfinite(exact) and exact < FAILED_RESIDUAL**2:
-            worst = max(worst, abs(values[j] - exact) / max(exact, 1e-300))
-        elif values[j] < FAILED_RESIDUAL**2:
-            worst = np.inf   # solved by the screen, not exactly
+        exact_ok = np.isfinite(exact) and exact < FAILED_RESIDUAL**2
+        if values[j] < FAILED_RESIDUAL**2:   # the screen's error where both solved it
+            worst = max(worst, abs(values[j] - exact) / max(exact, 1e-300)
+                        if exact_ok else np.inf)
         out[j] = exact
     if worst > MARGIN / 4:
         TALLY["fallback"] += 1
@@ -103,12 +104,18 @@ def screen(residual, zs) -> np.ndarray | None:
         models = [residual.model_at(z) for z in zs]
         if condensed(models[0]):
             return None
-        discs = [discretise(m) for m in models]
+        d0 = discretise(models[0])
+        free = d0.free
+        n_model = model_modes(models[0], d0, measured)
+        n_basis = n_model + EXTRA_MODES
+        limit = LOCAL_FRACTION * free.size
+        if n_basis >= limit:
+            return None   # a small model: its basis would be the model (a 10-element beam)
+        discs = [d0] + [discretise(m) for m in models[1:]]
         matrices = [d.global_matrices() for d in discs]
     except _TRIAL_ERRORS:
         return None
-    d0, (K0, M0) = discs[0], matrices[0]
-    free = d0.free
+    K0, M0 = matrices[0]
     if any(K.shape != K0.shape or not np.array_equal(d.free, free)
            for d, (K, _) in zip(discs, matrices)):
         return None   # the mesh itself differs from point to point (a released joint)
@@ -123,13 +130,13 @@ def screen(residual, zs) -> np.ndarray | None:
                 ((sp.coo_matrix(K - K0), tiny[0]), (sp.coo_matrix(M - M0), tiny[1]))]
         rows = index[np.concatenate(rows)]
         sets.append(np.unique(rows[rows >= 0]))
+    # a basis (its modes and static responses) of at most LOCAL_FRACTION of the free DOFs:
+    # one for the grid, else one for each set of DOFs a point differs on
     union = np.unique(np.concatenate(sets))
-    limit = LOCAL_FRACTION * free.size
-    if union.size > limit and max(len(a) for a in sets) > limit:
+    shared = n_basis + union.size <= limit
+    if not shared and n_basis + max(len(a) for a in sets) > limit:
         return None
     try:
-        n_model = model_modes(models[0], d0, measured)
-        n_basis = min(n_model + EXTRA_MODES, free.size - 1)
         first = solve_modes(K0, M0, n_basis, d0.constrained, d0.eigenvalue_scale,
                             dense=getattr(d0, "dense_solve", None)).shapes[free]
         Kf = sp.csc_matrix(K0)[free][:, free]
@@ -155,7 +162,7 @@ def screen(residual, zs) -> np.ndarray | None:
     screened = []
     for model, disc, (K, M), local in zip(models, discs, matrices, sets):
         try:
-            T = basis(union if union.size <= limit else local)
+            T = basis(union if shared else local)
             n = model_modes(model, disc, measured)
             if n > T.shape[1]:
                 raise ValueError("more modes than the basis holds")
