@@ -118,10 +118,7 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
         raise GfeSolverError(f"eigen solve failed: {exc}") from exc
     order = np.argsort(lam)
     lam, vec = lam[order], vec[:, order]
-    # rigid-body eigenvalues come out as roundoff (either sign): clamp to zero what is tiny
-    # next to the largest eigenvalue computed
-    roundoff = max(1e-9 * eigenvalue_scale, roundoff_fraction * float(np.max(np.abs(lam))))
-    lam = np.where(np.abs(lam) < roundoff, 0.0, lam)
+    lam = rigid_as_zero(lam, eigenvalue_scale, roundoff_fraction)
     if np.any(lam < 0):
         raise GfeSolverError(f"eigen solve returned negative eigenvalues {lam[lam < 0]}: "
                              "the stiffness is not positive semidefinite (a compression above "
@@ -130,8 +127,20 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     shapes[free] = d[:, None] * vec
     gen_mass = np.einsum("ij,ij->j", shapes, M @ shapes)
     shapes /= np.sqrt(gen_mass)
-    shapes *= np.sign(shapes[peak_rows(shapes), np.arange(n_modes)])
-    return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=shapes)
+    return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=signed(shapes))
+
+
+def rigid_as_zero(lam, eigenvalue_scale: float, roundoff_fraction: float = 1e-8):
+    """Rigid-body eigenvalues come out as roundoff (either sign): zero what is tiny next to
+    the largest eigenvalue computed (and to 1e-9 of the model's eigenvalue scale)."""
+    roundoff = max(1e-9 * eigenvalue_scale, roundoff_fraction * float(np.max(np.abs(lam))))
+    return np.where(np.abs(lam) < roundoff, 0.0, lam)
+
+
+def signed(shapes) -> np.ndarray:
+    """``shapes`` (in place) with each mode's peak (:func:`peak_rows`) positive."""
+    shapes *= np.sign(shapes[peak_rows(shapes), np.arange(shapes.shape[1])])
+    return shapes
 
 
 def _restricted(A, free, d):

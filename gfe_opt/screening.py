@@ -45,7 +45,7 @@ import scipy.sparse.linalg as spla
 
 from .assembly import discretise
 from .errors import GfeSolverError
-from .modal import Modes, condensed, solve_modes
+from .modal import Modes, condensed, rigid_as_zero, signed, solve_modes
 
 #: the screen's basis (the first point's modes and the static responses) holds at most this
 #: fraction of the free DOFs, else the points are solved one by one (a small model: its
@@ -60,7 +60,8 @@ SHORTLIST = 3
 RELATIVE_CHANGE = 1e-12
 #: modes of the first point in the basis beyond those the residual pairs
 EXTRA_MODES = 10
-#: fewer points than this are solved one by one (the basis costs about as much as 3 solves)
+#: fewer points than this are solved one by one (a basis costs a solve with more modes, a
+#: factorisation and a QR: not worth it for a handful of points; not tuned)
 MIN_POINTS = 8
 #: screens run and screens that fell back to solving every point (tests and benchmarks
 #: read them)
@@ -197,15 +198,10 @@ def _reduced_modes(K, M, T, n_modes, eigenvalue_scale) -> Modes:
     """The ``n_modes`` lowest modes of (K, M) in the basis ``T`` (zero at the constrained
     DOFs), mass normalised (by the reduced solve), each signed as
     :func:`~gfe_opt.modal.solve_modes` signs them."""
-    from .modal import peak_rows
-
     Kr, Mr = T.T @ (K @ T), T.T @ (M @ T)
     lam, q = sla.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T),
                       subset_by_index=[0, n_modes - 1])
-    roundoff = max(1e-9 * eigenvalue_scale, 1e-8 * float(np.max(np.abs(lam))))
-    lam = np.where(np.abs(lam) < roundoff, 0.0, lam)
+    lam = rigid_as_zero(lam, eigenvalue_scale)
     if np.any(lam < 0):
         raise GfeSolverError("negative eigenvalue in the screened solve")
-    shapes = T @ q
-    shapes *= np.sign(shapes[peak_rows(shapes), np.arange(n_modes)])
-    return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=shapes)
+    return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=signed(T @ q))
