@@ -808,12 +808,21 @@ def _member_bending(model: FrameModel, member: Member, L: float) -> np.ndarray:
         lo = max(int((x_c - CRACK_REACH * decay) // L), 0)
         hi = min(int((x_c + CRACK_REACH * decay) // L) + 1, member.elements)
         reached.update(range(lo, hi))
+    plain = []
     for j in sorted(reached):
         x0 = j * L
         inside = (*(x_c for x_c, _ in cracks if x0 < x_c < x0 + L), *_edges(zones, x0, L),
                   *(() if profile is None else (k for k in profile[0] if x0 < k < x0 + L)))
+        if not inside:
+            plain.append(j)
+            continue
         out[j] = el.beam_stiffness_from_flexibility(rigidity, x0, L, breakpoints=inside,
                                                     refine_scale=decay)
+    if plain:   # the elements with no kink inside, together: the same points and sums
+        j = np.array(plain)
+        x, w = el.element_quadratures(j * L, j * L + L)
+        out[j] = np.stack(el.flexibility_parameters(x - (j * L)[:, None], w / rigidity(x), L),
+                          axis=1)
     return out
 
 
@@ -827,16 +836,27 @@ def _member_axial(model: FrameModel, member: Member, L: float) -> np.ndarray:
     out = np.full(member.elements, model.stiffness_factor * member.E * member.area * ratio)
     zones = _zones(model, member.id)
     for j, _, x, w in _zoned_quadrature(zones, L, member.elements):
-        out[j] *= L / np.sum(w / _zone_factor(zones, 3)(x))
+        out[j] *= L / np.sum(w / _zone_factor(zones, 3)(x), axis=-1)
     return out
 
 
 def _zoned_quadrature(zones, L: float, count: int):
-    """For each element of a member (``count`` elements ``L`` long) that a section-loss
-    zone covers, even in part: (its index, its start x0 along the member, quadrature points
-    x and weights w exact for the zones' piecewise-constant ratios)."""
+    """The elements of a member (``count`` elements ``L`` long) that a section-loss zone
+    covers, even in part: (their indices, their starts x0 along the member, quadrature
+    points x and weights w exact for the zones' piecewise-constant ratios, a row an
+    element): each element with a zone's edge inside alone, the others together (the same
+    numbers as one at a time)."""
+    whole = []
     for j in _zoned_elements(zones, L, count):
-        x, w = el.element_quadrature(j * L, (j + 1) * L, _edges(zones, j * L, L))
+        edges = _edges(zones, j * L, L)
+        if not edges:
+            whole.append(j)
+            continue
+        x, w = el.element_quadrature(j * L, (j + 1) * L, edges)
+        yield np.array([j]), np.array([j * L]), x[None, :], w[None, :]
+    if whole:
+        j = np.array(whole)
+        x, w = el.element_quadratures(j * L, (j + 1) * L)
         yield j, j * L, x, w
 
 
@@ -845,21 +865,32 @@ def _edges(zones, x0: float, L: float) -> tuple:
     return tuple(edge for z in zones for edge in z[:2] if x0 < edge < x0 + L)
 
 
-def _zone_mass(zones, rhoA: float, x0: float, L: float, x, w) -> np.ndarray:
-    """(6, 6) local mass a member's section-loss zones add to the element [x0, x0 + L]:
-    ρA (mass ratio − 1) ∫ NᵀN over the part covered (bar and beam shape functions, exact
-    quadrature ``x``, ``w``)."""
-    return _added_mass(rhoA * w * (_zone_factor(zones, 3)(x) - 1.0), x0, L, x)
+def _zone_mass(zones, rhoA, x0, L: float, x, w) -> np.ndarray:
+    """(..., 6, 6) local mass a member's section-loss zones add to the elements
+    [x0, x0 + L] (``rhoA`` and ``x0`` one value an element, ``x``, ``w`` a row): ρA (mass
+    ratio − 1) ∫ NᵀN over the part covered (bar and beam shape functions, exact
+    quadrature)."""
+    return _added_mass(np.asarray(rhoA)[..., None] * w * (_zone_factor(zones, 3)(x) - 1.0),
+                       x0, L, x)
+
+
+#: the axial (u) and bending (w, θ) rows and columns of a frame element's six local DOFs, as
+#: index arrays (``A[_AXIAL]`` is the 2 x 2 block, ``A[_EACH_AXIAL]`` each element's)
+_AXIAL = np.ix_([0, 3], [0, 3])
+_BENDING = np.ix_([1, 2, 4, 5], [1, 2, 4, 5])
+_EACH_AXIAL = (slice(None), *_AXIAL)
+_EACH_BENDING = (slice(None), *_BENDING)
 
 
 def _added_mass(c, x0: float, L: float, x) -> np.ndarray:
-    """(6, 6) local mass Σ c NᵀN of the element [x0, x0 + L] at points ``x`` with weights
-    ``c`` (the added ρA times the quadrature weight; bar and beam shape functions)."""
-    s = (x - x0) / L
-    added = np.zeros((6, 6))
+    """(..., 6, 6) local mass Σ c NᵀN of the elements [x0, x0 + L] at points ``x`` with
+    weights ``c`` (the added ρA times the quadrature weight; bar and beam shape functions;
+    the points on the last axis, ``x0`` one value a row)."""
+    s = (x - np.asarray(x0)[..., None]) / L
+    added = np.zeros(x.shape[:-1] + (6, 6))
     bar, beam = el.linear(s), el.hermite(s) * el.beam_dof_scaling(np.array([L]))[0]
-    added[np.ix_([0, 3], [0, 3])] = bar.T @ (c[:, None] * bar)
-    added[np.ix_([1, 2, 4, 5], [1, 2, 4, 5])] = beam.T @ (c[:, None] * beam)
+    added[(..., *_AXIAL)] = np.swapaxes(bar, -1, -2) @ (c[..., None] * bar)
+    added[(..., *_BENDING)] = np.swapaxes(beam, -1, -2) @ (c[..., None] * beam)
     return added
 
 
@@ -875,9 +906,8 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
     rhoA = np.full(n, member.rho * member.area)
     local_k = np.zeros((n, 6, 6))
     local_m = np.zeros((n, 6, 6))
-    axial, bend = [0, 3], [1, 2, 4, 5]
-    local_k[np.ix_(range(n), axial, axial)] = el.generic_bar_stiffness(EA, L)
-    local_m[np.ix_(range(n), axial, axial)] = el.generic_bar_mass(
+    local_k[_EACH_AXIAL] = el.generic_bar_stiffness(EA, L)
+    local_m[_EACH_AXIAL] = el.generic_bar_mass(
         rhoA, L, np.full(n, el.BAR_MASS_BETA["consistent"]))
     p = _member_bending(model, member, L[0])
     kGA = member_shear_rigidity(model, member)
@@ -886,7 +916,7 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
         g = el.shear_parameter(p[:, 0] / 12.0, kGA, L)
         soft = el.timoshenko_correction({"k_ww": p[:, 0], "k_wt": p[:, 1], "k_tt": p[:, 2]}, g)
         p = np.stack([soft["k_ww"], soft["k_wt"], soft["k_tt"]], axis=1)
-    local_k[np.ix_(range(n), bend, bend)] = bending_stiffness(p, L)
+    local_k[_EACH_BENDING] = bending_stiffness(p, L)
     scaling = el.beam_dof_scaling(L)                     # (n, 4)
     if kGA is None:
         mass_params = el.CONSISTENT_BEAM_MASS
@@ -899,14 +929,14 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
         mass = mass + el.timoshenko_rotary_inertia(
             np.full(n, member.rho * member.inertia), L,
             el.shear_parameter(np.full(n, ei), kGA, L))
-    local_m[np.ix_(range(n), bend, bend)] = mass * scaling[:, :, None] * scaling[:, None, :]
+    local_m[_EACH_BENDING] = mass * scaling[:, :, None] * scaling[:, None, :]
     tension = _member_tension(model, member)
     if tension:   # geometric stiffness T ∫ N'ᵀN' dx of the transverse motion
-        local_k[np.ix_(range(n), bend, bend)] += tension * slope_gram(L[0]) \
+        local_k[_EACH_BENDING] += tension * slope_gram(L[0]) \
             * scaling[:, :, None] * scaling[:, None, :]
     foundation = _member_value(model, member, "foundation", "stiffness")
     if foundation:   # k_f ∫ NᵀN dx of the transverse motion (the beam's foundation)
-        local_k[np.ix_(range(n), bend, bend)] += foundation * L[0] * el.HERMITE_GRAM \
+        local_k[_EACH_BENDING] += foundation * L[0] * el.HERMITE_GRAM \
             * scaling[:, :, None] * scaling[:, None, :]
     zones = _zones(model, member.id)
     for j, start, x, w in _zoned_quadrature(zones, L[0], n):
