@@ -591,6 +591,16 @@ class FrameMesh:
     #: by the copies that carry other spring values
     patterns: dict = field(default_factory=dict, compare=False, repr=False)
 
+    @property
+    def free(self) -> np.ndarray:
+        """The DOFs the supports leave free (read-only; computed once a mesh)."""
+        free = self.patterns.get("free")
+        if free is None:
+            free = np.setdiff1d(np.arange(self.n_dof), self.constrained)
+            free.flags.writeable = False
+            self.patterns["free"] = free
+        return free
+
 
 #: the meshes built, by what decides their nodes and numbering (:func:`_mesh_key`): a fit
 #: changes only the spring values a mesh carries, and rebuilding it cost 3.9 s of the
@@ -894,29 +904,40 @@ def _added_mass(c, x0: float, L: float, x) -> np.ndarray:
     return added
 
 
-def _member_elements(model: FrameModel, k: int) -> MemberElements:
-    """One member's elements: bar ⊕ beam in the member's axes, rotated into global axes by
-    T = diag(R, R)."""
-    member = model.members[k]
-    n = member.elements
+@dataclass(frozen=True)
+class _MemberStatic:
+    """What a member's elements share whatever the effects that move in a fit (cracks,
+    zones, profiles, tension, foundation, the material's stiffness): element lengths, ρA,
+    the DOF scaling and its outer product, the local mass of bar ⊕ beam (Timoshenko's when
+    the member is), the rotation T and Tᵀ, and M in global axes (a member no zone or mass
+    profile changes)."""
+
+    L: np.ndarray
+    rhoA: np.ndarray
+    scaling2: np.ndarray
+    local_m: np.ndarray
+    T: np.ndarray
+    Tt: np.ndarray
+    M: np.ndarray
+
+
+_MEMBER_STATIC: dict = {}
+
+
+def _member_static(model: FrameModel, member: Member, kGA) -> _MemberStatic:
     (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
+    key = (member, x0, y0, x1, y1, kGA,
+           None if kGA is None else model.stiffness_factor)
+    kept = _MEMBER_STATIC.get(key)
+    if kept is not None:
+        return kept
+    n = member.elements
     length = math.hypot(x1 - x0, y1 - y0)
     L = np.full(n, length / member.elements)
-    EA = _member_axial(model, member, L[0])
     rhoA = np.full(n, member.rho * member.area)
-    local_k = np.zeros((n, 6, 6))
     local_m = np.zeros((n, 6, 6))
-    local_k[_EACH_AXIAL] = el.generic_bar_stiffness(EA, L)
     local_m[_EACH_AXIAL] = el.generic_bar_mass(
         rhoA, L, np.full(n, el.BAR_MASS_BETA["consistent"]))
-    p = _member_bending(model, member, L[0])
-    kGA = member_shear_rigidity(model, member)
-    g = None
-    if kGA is not None:   # eq. 18's shear softening of each element, its own EI (a crack's)
-        g = el.shear_parameter(p[:, 0] / 12.0, kGA, L)
-        soft = el.timoshenko_correction({"k_ww": p[:, 0], "k_wt": p[:, 1], "k_tt": p[:, 2]}, g)
-        p = np.stack([soft["k_ww"], soft["k_wt"], soft["k_tt"]], axis=1)
-    local_k[_EACH_BENDING] = bending_stiffness(p, L)
     scaling = el.beam_dof_scaling(L)                     # (n, 4)
     if kGA is None:
         mass_params = el.CONSISTENT_BEAM_MASS
@@ -930,30 +951,60 @@ def _member_elements(model: FrameModel, k: int) -> MemberElements:
             np.full(n, member.rho * member.inertia), L,
             el.shear_parameter(np.full(n, ei), kGA, L))
     local_m[_EACH_BENDING] = mass * scaling[:, :, None] * scaling[:, None, :]
+    T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
+    Tt = np.swapaxes(T, 1, 2)
+    kept = _MemberStatic(L, rhoA, scaling[:, :, None] * scaling[:, None, :], local_m, T, Tt,
+                         Tt @ local_m @ T)
+    for array in (kept.L, kept.rhoA, kept.scaling2, kept.local_m, kept.T, kept.Tt, kept.M):
+        array.flags.writeable = False
+    if len(_MEMBER_STATIC) >= _MEMBER_ELEMENTS_KEPT:
+        _MEMBER_STATIC.clear()
+    _MEMBER_STATIC[key] = kept
+    return kept
+
+
+def _member_elements(model: FrameModel, k: int) -> MemberElements:
+    """One member's elements: bar ⊕ beam in the member's axes, rotated into global axes by
+    T = diag(R, R) (what does not change with the effects from :func:`_member_static`)."""
+    member = model.members[k]
+    n = member.elements
+    kGA = member_shear_rigidity(model, member)
+    static = _member_static(model, member, kGA)
+    L, rhoA = static.L, static.rhoA
+    EA = _member_axial(model, member, L[0])
+    local_k = np.zeros((n, 6, 6))
+    local_k[_EACH_AXIAL] = el.generic_bar_stiffness(EA, L)
+    p = _member_bending(model, member, L[0])
+    g = None
+    if kGA is not None:   # eq. 18's shear softening of each element, its own EI (a crack's)
+        g = el.shear_parameter(p[:, 0] / 12.0, kGA, L)
+        soft = el.timoshenko_correction({"k_ww": p[:, 0], "k_wt": p[:, 1], "k_tt": p[:, 2]}, g)
+        p = np.stack([soft["k_ww"], soft["k_wt"], soft["k_tt"]], axis=1)
+    local_k[_EACH_BENDING] = bending_stiffness(p, L)
     tension = _member_tension(model, member)
     if tension:   # geometric stiffness T ∫ N'ᵀN' dx of the transverse motion
-        local_k[_EACH_BENDING] += tension * slope_gram(L[0]) \
-            * scaling[:, :, None] * scaling[:, None, :]
+        local_k[_EACH_BENDING] += tension * slope_gram(L[0]) * static.scaling2
     foundation = _member_value(model, member, "foundation", "stiffness")
     if foundation:   # k_f ∫ NᵀN dx of the transverse motion (the beam's foundation)
-        local_k[_EACH_BENDING] += foundation * L[0] * el.HERMITE_GRAM \
-            * scaling[:, :, None] * scaling[:, None, :]
+        local_k[_EACH_BENDING] += foundation * L[0] * el.HERMITE_GRAM * static.scaling2
+    local_m = None
     zones = _zones(model, member.id)
     for j, start, x, w in _zoned_quadrature(zones, L[0], n):
+        local_m = static.local_m.copy() if local_m is None else local_m
         local_m[j] += _zone_mass(zones, rhoA[j], start, L[0], x, w)
     profile = next(((np.asarray(e["x"], float), np.asarray(e["ratio"], float))
                     for e in model.raw_effects
                     if e["effect"] == "mass_profile" and e["member"] == member.id), None)
     if profile is not None:   # ρA × its piecewise-linear ratio on every element
+        local_m = static.local_m.copy() if local_m is None else local_m
         for j in range(n):
             start = j * L[0]
             x, w = el.element_quadrature(start, start + L[0], tuple(
                 k for k in profile[0] if start < k < start + L[0]))
             local_m[j] += _added_mass(rhoA[j] * w * (np.interp(x, *profile) - 1.0), start,
                                       L[0], x)
-    T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
-    Tt = np.swapaxes(T, 1, 2)
-    return MemberElements(p, EA, Tt @ local_k @ T, Tt @ local_m @ T, tension, foundation, g)
+    M = static.M if local_m is None else static.Tt @ local_m @ static.T
+    return MemberElements(p, EA, static.Tt @ local_k @ static.T, M, tension, foundation, g)
 
 
 def bending_stiffness(p, L) -> np.ndarray:
@@ -1124,7 +1175,7 @@ class FrameDiscretisation:
         self.n_elements = model.n_elements
         self.n_dof = self.mesh.n_dof
         self.constrained = self.mesh.constrained
-        self.free = np.setdiff1d(np.arange(self.n_dof), self.constrained)
+        self.free = self.mesh.free
         #: LAPACK's dense solve up to :data:`DENSE_SOLVE_DOFS` free DOFs, shift-invert
         #: Lanczos on the sparse pencil above (the modes agree to 1e-9, the Rayleigh
         #: quotients to rounding)

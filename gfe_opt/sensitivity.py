@@ -69,8 +69,13 @@ def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None):
             if np.count_nonzero(close) > 1:
                 raise RepeatedEigenvalue(f"eigenvalue {lam[j]:.6g} is repeated")
     Kf, Mf = _sub(K, free), _sub(M, free)
-    dKf = [_sub(_as(d, dense), free) for d in dK]
-    dMf = [_sub(_as(d, dense), free) for d in dM]
+    if dense:
+        dKf = [_sub(_as(d, dense), free) for d in dK]
+        dMf = [_sub(_as(d, dense), free) for d in dM]
+    else:   # products over all DOFs, then the free rows: the shapes are zero elsewhere, so
+        # the same sums term by term as the free block's (slicing each cost more than them)
+        dKf = [_FreeRows(sp.csr_matrix(d), free) for d in dK]
+        dMf = [_FreeRows(sp.csr_matrix(d), free) for d in dM]
     kd = np.abs(Kf.diagonal())
     d = 1.0 / np.sqrt(np.where(kd > 0, kd, 1.0))
     if dense:
@@ -82,9 +87,11 @@ def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None):
         x = phi[free, j]
         Mx = Mf @ x
         # derivatives of λ: φᵀ(K' − λM')φ
-        g = np.column_stack([dKf[k] @ x - lam[j] * (dMf[k] @ x) for k in range(p)])
+        xk = x if dense else phi[:, j]
+        Mxk = [dMf[k] @ xk for k in range(p)]
+        g = np.column_stack([dKf[k] @ xk - lam[j] * Mxk[k] for k in range(p)])
         dlam[j] = x @ g
-        half = np.array([-0.5 * float(x @ (dMf[k] @ x)) for k in range(p)])
+        half = np.array([-0.5 * float(x @ Mxk[k]) for k in range(p)])
         rhs_top = -g + np.outer(Mx, dlam[j])
         border = d * Mx
         beta = 1.0 / np.linalg.norm(border)
@@ -115,6 +122,16 @@ def _nelson(pencil, lam, xs, d, rhs_top, Mx, half):
     v = d[:, None] * v                                  # back to physical coordinates
     c = half - Mx @ v
     return v + np.outer(d * xs, c)
+
+
+class _FreeRows:
+    """``A @ v`` restricted to the rows ``free``, for ``v`` over all DOFs."""
+
+    def __init__(self, A, free):
+        self.A, self.free = A, free
+
+    def __matmul__(self, v):
+        return (self.A @ v)[self.free]
 
 
 class _Pencil:
