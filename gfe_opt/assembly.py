@@ -306,32 +306,45 @@ class Builder:
         model = self.model
         n, L = model.elements, model.element_length
         rho_a = model.mass_per_length
-        if model.kind == "bar":
-            beta = el.BAR_MASS_BETA[model.mass_model]
-            mass = el.generic_bar_mass(np.full(n, rho_a), L, np.full(n, beta))
-            shape, scaling = el.linear, np.ones(2)
-        else:
-            if self.shear_rigidity is not None:
-                ei = E * model.inertia
-                g = el.shear_parameter(ei, self.shear_rigidity, L)
-                _, mass_params = el.timoshenko_parameters(ei, self.shear_rigidity, L)
-            else:
-                g = 0.0
-                mass_params = {"consistent": el.CONSISTENT_BEAM_MASS,
-                               "higher_order": el.HIGHER_ORDER_BEAM_MASS}[model.mass_model]
-            scaled = rho_a * L * el.symmetric_beam_mass(**{k: np.full(n, v)
-                                                           for k, v in mass_params.items()})
-            if self.shear_rigidity is not None:
-                scaled = scaled + el.timoshenko_rotary_inertia(
-                    np.full(n, model.rho * model.inertia), L, np.full(n, g))
-            scaling = el.beam_dof_scaling(L)
-            mass = scaled * np.outer(scaling, scaling)
-            shape = el.hermite
+        shape, scaling = (el.linear, np.ones(2)) if model.kind == "bar" else (
+            el.hermite, el.beam_dof_scaling(L))
+        mass = _uniform_mass(model.kind, n, L, rho_a, model.mass_model, E, model.inertia,
+                             model.rho, self.shear_rigidity).copy()
         for elements, s, w, x in _quadrature(model, self.mass):
             N = shape(s / L) * scaling
             change = rho_a * w * (_product(self.mass, x) - 1.0)
             mass[elements] += np.swapaxes(N, -1, -2) @ (change[..., None] * N)
         return mass
+
+
+@lru_cache(maxsize=64)
+def _uniform_mass(kind, n, L, rho_a, mass_model, E, inertia, rho, shear_rigidity):
+    """The element masses of a uniform beam or bar (read-only; kept: a fit's effects that
+    leave the mass alone rebuild the model at every evaluation)."""
+    mass = _uniform_mass_of(kind, n, L, rho_a, mass_model, E, inertia, rho, shear_rigidity)
+    mass.flags.writeable = False
+    return mass
+
+
+def _uniform_mass_of(kind, n, L, rho_a, mass_model, E, inertia, rho, shear_rigidity):
+    if kind == "bar":
+        beta = el.BAR_MASS_BETA[mass_model]
+        return el.generic_bar_mass(np.full(n, rho_a), L, np.full(n, beta))
+    if shear_rigidity is not None:
+        ei = E * inertia
+        g = el.shear_parameter(ei, shear_rigidity, L)
+        _, mass_params = el.timoshenko_parameters(ei, shear_rigidity, L)
+    else:
+        g = 0.0
+        mass_params = {"consistent": el.CONSISTENT_BEAM_MASS,
+                       "higher_order": el.HIGHER_ORDER_BEAM_MASS}[mass_model]
+    scaled = rho_a * L * el.symmetric_beam_mass(**{k: np.full(n, v)
+                                                   for k, v in mass_params.items()})
+    if shear_rigidity is not None:
+        scaled = scaled + el.timoshenko_rotary_inertia(np.full(n, rho * inertia), L,
+                                                       np.full(n, g))
+    scaling = el.beam_dof_scaling(L)
+    return scaled * np.outer(scaling, scaling)
 
 
 def _product(factors, x):
