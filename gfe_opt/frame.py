@@ -1211,19 +1211,23 @@ class FrameDiscretisation:
         no energy (a spring to ground takes one away)."""
         import scipy.linalg as sla
 
-        xy = self.mesh.xy
-        n = xy.shape[0]
-        basis = np.zeros((self.n_dof, 3))
-        basis[0:3 * n:3, 0] = 1.0
-        basis[1:3 * n:3, 1] = 1.0
-        basis[0:3 * n:3, 2], basis[1:3 * n:3, 2] = -xy[:, 1], xy[:, 0]
-        basis[2:3 * n:3, 2] = 1.0
-        basis[3 * n:, 2] = 1.0                      # members' own end rotations
-        fixed = basis[self.constrained]
-        null = sla.null_space(fixed) if fixed.size else np.eye(3)
-        if null.shape[1] == 0:
+        motions = self.mesh.patterns.get("rigid")   # the supports' own, once a mesh
+        if motions is None:
+            xy = self.mesh.xy
+            n = xy.shape[0]
+            basis = np.zeros((self.n_dof, 3))
+            basis[0:3 * n:3, 0] = 1.0
+            basis[1:3 * n:3, 1] = 1.0
+            basis[0:3 * n:3, 2], basis[1:3 * n:3, 2] = -xy[:, 1], xy[:, 0]
+            basis[2:3 * n:3, 2] = 1.0
+            basis[3 * n:, 2] = 1.0                      # members' own end rotations
+            fixed = basis[self.constrained]
+            null = sla.null_space(fixed) if fixed.size else np.eye(3)
+            motions = basis @ null
+            motions.flags.writeable = False
+            self.mesh.patterns["rigid"] = motions
+        if motions.shape[1] == 0:
             return 0
-        motions = basis @ null
         k = motions.shape[1]
         pairs = np.stack([motions[:, i] + motions[:, j] for i in range(k) for j in range(k)],
                          1)
