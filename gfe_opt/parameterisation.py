@@ -18,11 +18,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-import sympy
+
+if TYPE_CHECKING:   # loaded where it is used: a diagnosis does not need sympy
+    import sympy
 
 PARAMETERISATIONS = ("element", "nodal", "linear", "constant")
 
@@ -30,7 +33,10 @@ PARAMETERISATIONS = ("element", "nodal", "linear", "constant")
 @lru_cache(maxsize=1)
 def derive_nodal_coefficients() -> sympy.Matrix:
     """Eq. 13 by exact integration: rows k_ww, k_wt, k_tt; columns k_i, k'_i L, k_{i+1},
-    k'_{i+1} L (sympy Rationals)."""
+    k'_{i+1} L (sympy Rationals; sympy is loaded here, not with the module: the fits and a
+    diagnosis use :func:`nodal_coefficients`)."""
+    import sympy
+
     xi = sympy.Symbol("xi")
     hermite = [1 - 3 * xi**2 + 2 * xi**3, xi - 2 * xi**2 + xi**3, 3 * xi**2 - 2 * xi**3,
                -(xi**2) + xi**3]

@@ -72,8 +72,8 @@ def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None):
     if dense:
         dKf = [_sub(_as(d, dense), free) for d in dK]
         dMf = [_sub(_as(d, dense), free) for d in dM]
-    else:   # products over all DOFs, then the free rows: the shapes are zero elsewhere, so
-        # the same sums term by term as the free block's (slicing each cost more than them)
+    else:   # products over all DOFs with the shape zero off the free ones, then the free
+        # rows: the same sums term by term as the free block's (slicing cost more than them)
         dKf = [_FreeRows(sp.csr_matrix(d), free) for d in dK]
         dMf = [_FreeRows(sp.csr_matrix(d), free) for d in dM]
     kd = np.abs(Kf.diagonal())
@@ -87,7 +87,11 @@ def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None):
         x = phi[free, j]
         Mx = Mf @ x
         # derivatives of λ: φᵀ(K' − λM')φ
-        xk = x if dense else phi[:, j]
+        if dense:
+            xk = x
+        else:
+            xk = np.zeros(n_dof)
+            xk[free] = x
         Mxk = [dMf[k] @ xk for k in range(p)]
         g = np.column_stack([dKf[k] @ xk - lam[j] * Mxk[k] for k in range(p)])
         dlam[j] = x @ g

@@ -1126,3 +1126,54 @@ def test_batch_on_a_frame_follows_joints_that_loosen(tmp_path):
                               "joint_spring#2": "node=C, member=beam"}
     assert "joint_spring#2 (node=C, member=beam)" in format_trend(summary)
     assert summary.to_json()["places"] == summary.places
+
+
+def test_a_members_elements_together_are_each_element_alone():
+    """A member's elements with no kink inside are integrated together
+    (:func:`~gfe_opt.elements.element_quadratures`), and its effect-free parts are kept
+    between models: each element's bending parameters, axial rigidity and matrices are the
+    numbers its own quadrature gives, bit for bit (a crack and a stiffer, heavier zone on
+    the beam, the beam built first without them)."""
+    from gfe_opt import elements as el
+    from gfe_opt.effects.crack import CRACK_REACH
+    from gfe_opt.frame import _member_elements
+
+    base = portal_frame()
+    k = [m.id for m in base.members].index("beam")
+    _member_elements(base, k)   # the member's effect-free parts kept from here
+    model = base.with_effects([
+        Effect("crack", {"member": "beam", "position": 0.13, "depth_ratio": 0.4}),
+        Effect("section_loss", {"member": "beam", "position": 0.3, "length": 0.08,
+                                "stiffness_ratio": 1.6, "mass_ratio": 1.2})])
+    found = _member_elements(model, k)
+    member = model.members[k]
+    n = member.elements
+    L = model.member_length(member) / n
+    ei0, ea0 = member.E * member.inertia, member.E * member.area
+    half = member.depth / 2.0
+    zone = (0.3 - 0.08 / 2.0, 0.3 + 0.08 / 2.0)   # as the effect places it
+
+    def rigidity(x):   # EI times the zone's ratio times the crack's, as the member has it
+        q = np.ones_like(x) * np.where((x >= zone[0]) & (x <= zone[1]), 1.6, 1.0)
+        return ei0 * (q * el.christides_barr_q(x, 0.13, 0.4, half))
+
+    decay = half / (2.0 * el.SHEN_PIERRE_GAMMA)
+    reach = [j for j in range(n) if (0.13 - CRACK_REACH * decay) // L <= j
+             <= (0.13 + CRACK_REACH * decay) // L or (j + 1) * L > zone[0] and j * L < zone[1]]
+    assert len(reach) >= 6
+    for j in reach:
+        x0 = j * L
+        kinks = tuple(b for b in (0.13, *zone) if x0 < b < x0 + L)
+        alone = el.beam_stiffness_from_flexibility(rigidity, x0, L, breakpoints=kinks,
+                                                   refine_scale=decay)
+        assert tuple(found.bending[j]) == alone
+        if (j + 1) * L > zone[0] and j * L < zone[1]:
+            x, w = el.element_quadrature(j * L, (j + 1) * L,
+                                         tuple(b for b in zone if j * L < b < (j + 1) * L))
+            ratio = np.where((x >= zone[0]) & (x <= zone[1]), 1.2, 1.0)
+            assert found.axial[j] == ea0 * (L / np.sum(w / ratio))
+    plain = _member_elements(base, k)
+    untouched = [j for j in range(n) if j not in reach]
+    assert untouched
+    assert np.array_equal(plain.K[untouched], found.K[untouched])
+    assert np.array_equal(plain.M[untouched], found.M[untouched])
