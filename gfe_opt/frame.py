@@ -587,8 +587,9 @@ class FrameMesh:
     grounded: tuple                 # (dof, k): a support that gives
     n_dof: int
     constrained: np.ndarray
-    #: the sparse patterns of K and M (:func:`_assemble`), computed once a mesh and shared
-    #: by the copies that carry other spring values
+    #: what depends on the mesh alone, computed once a mesh and shared by the copies that
+    #: carry other spring values: the sparse patterns of K and M (:func:`_assemble`), the
+    #: free DOFs (:attr:`free`), the supports' rigid motions (``rigid_body_count``)
     patterns: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
@@ -925,6 +926,8 @@ _MEMBER_STATIC: dict = {}
 
 
 def _member_static(model: FrameModel, member: Member, kGA) -> _MemberStatic:
+    """``member``'s :class:`_MemberStatic` (κGA ``kGA``, None: Euler–Bernoulli), kept by
+    what decides it (read-only arrays)."""
     (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
     key = (member, x0, y0, x1, y1, kGA,
            None if kGA is None else model.stiffness_factor)

@@ -28,6 +28,8 @@ _SYMBOLIC = ("x", "L", "u", "k", "m", "t", "shift", "taylor_expand_row", "bar_ro
 
 
 def __getattr__(name):
+    """``gfe_opt.realisation.bar_row`` and the other symbolic names, from
+    :mod:`gfe_opt.symbolic_rows` (PEP 562: sympy loads on the first such use)."""
     if name in _SYMBOLIC:
         from . import symbolic_rows
 
