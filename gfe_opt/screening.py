@@ -17,14 +17,12 @@ where a basis would hold more than that fraction (a uniform change of E; a model
 elements, whose basis would be the model), the grid is solved point by point as before
 (a reduced solve of half the size costs an eighth).  Measured on the portal's and the
 three-storey frame's grids (crack, point mass, point spring, section loss, axial load,
-joint spring): χ² within 1e-9 (median) and
-2e-5 (worst, relative) of the exact solve's; on the 46-element demo beam's (crack, point
-mass and spring, section loss, support spring; screened here without the size limit: a
-crack's Christides–Barr disturbance, above 1e-12 of the largest entry, reaches 0.2 m each
-way, and its basis there holds more than half the model) within 1e-8 and 1e-7, and on its
-support
-translation's 1.2e-4 (a grid of 5 points, below :data:`MIN_POINTS`: solved point by
-point).
+joint spring): χ² within 1e-9 (median) and 2e-5 (worst, relative) of the exact solve's;
+on the 46-element demo beam's (crack, point mass and spring, section loss, support spring;
+screened here without the size limit: a crack's Christides–Barr disturbance, above 1e-12
+of the largest entry, reaches 0.2 m each way, and its basis there holds more than half
+the model) within 1e-8 and 1e-7, and on its support translation's 1.2e-4 (a grid of 5
+points, below :data:`MIN_POINTS`: solved point by point).
 
 The screened values only choose which points are solved exactly: every point whose
 screened χ² lies within :data:`MARGIN` of the lowest, and the :data:`SHORTLIST` lowest
