@@ -437,16 +437,14 @@ def element_quadrature(x0, x1, breakpoints=(), refine_scale=None, order=6):
                 if x0 < c < x1:
                     cuts.add(c)
     cuts = np.array(sorted(cuts))
-    g, w = _gauss_legendre(order)
-    a, b = cuts[:-1, None], cuts[1:, None]
-    x = 0.5 * (b - a) * g + 0.5 * (a + b)
-    return x.ravel(), (0.5 * (b - a) * w).ravel()
+    x, w = element_quadratures(cuts[:-1], cuts[1:], order)
+    return x.ravel(), w.ravel()
 
 
 def element_quadratures(x0, x1, order=6):
-    """:func:`element_quadrature` of the elements [x0, x1] (arrays) with no breakpoint
-    inside, at once: points and weights (len(x0), order), each row the numbers the
-    element's own call gives."""
+    """Gauss–Legendre points and weights on each interval [x0, x1] (arrays), one row an
+    interval (len(x0), order): :func:`element_quadrature`'s pieces, and the elements with
+    no breakpoint inside at once (each row the numbers the element's own call gives)."""
     g, w = _gauss_legendre(order)
     a = np.asarray(x0, dtype=float)[:, None]
     b = np.asarray(x1, dtype=float)[:, None]
