@@ -115,31 +115,38 @@ def screen(residual, zs) -> np.ndarray | None:
         limit = LOCAL_FRACTION * free.size
         if n_basis >= limit:
             return None   # a small model: its basis would be the model (a 10-element beam)
-        discs = [d0] + [discretise(m) for m in models[1:]]
-        matrices = [d.global_matrices() for d in discs]
+        discs, matrices = [d0], [d0.global_matrices()]
     except _TRIAL_ERRORS:
         return None
     K0, M0 = matrices[0]
-    if any(K.shape != K0.shape or not np.array_equal(d.free, free)
-           for d, (K, _) in zip(discs, matrices)):
-        return None   # the mesh itself differs from point to point (a released joint)
     index = np.full(K0.shape[0], -1)
     index[free] = np.arange(free.size)
     # the DOFs where a point's K or M differs from the first point's beyond rounding (a
     # crack's disturbance decays without end: 1e-12 of the largest entry is no change)
     tiny = [RELATIVE_CHANGE * abs(A).max() for A in (K0, M0)]
     sets = []
-    for K, M in matrices:
+    for j, model in enumerate(models):
+        if j:
+            try:
+                discs.append(discretise(model))
+                matrices.append(discs[-1].global_matrices())
+            except _TRIAL_ERRORS:
+                return None
+        K, M = matrices[-1]
+        if K.shape != K0.shape or not np.array_equal(discs[-1].free, free):
+            return None   # the mesh itself differs from point to point (a released joint)
         rows = [D.row[np.abs(D.data) > t] for D, t in
                 ((sp.coo_matrix(K - K0), tiny[0]), (sp.coo_matrix(M - M0), tiny[1]))]
         rows = index[np.concatenate(rows)]
         sets.append(np.unique(rows[rows >= 0]))
+        if n_basis + len(sets[-1]) > limit:
+            # no basis serves this point (nor the grid, which holds it): solved one by one,
+            # known before the other points are assembled (a crack along a 46-element beam)
+            return None
     # a basis (its modes and static responses) of at most LOCAL_FRACTION of the free DOFs:
     # one for the grid, else one for each set of DOFs a point differs on
     union = np.unique(np.concatenate(sets))
     shared = n_basis + union.size <= limit
-    if not shared and n_basis + max(len(a) for a in sets) > limit:
-        return None
     try:
         first = solve_modes(K0, M0, n_basis, d0.constrained, d0.eigenvalue_scale,
                             dense=getattr(d0, "dense_solve", None)).shapes[free]
