@@ -216,19 +216,17 @@ def point_of(disc, K, M, modes, measured, noise: Noise, C=None) -> Point:
 
 
 def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upper,
-                   step: float = 1e-5, columns=None) -> np.ndarray:
+                   step: float = 1e-5) -> np.ndarray:
     """The Jacobian of the residual at ``point`` (the evaluation at z) with respect to z,
     the pairing held: eigenvalue and eigenvector derivatives
     (:func:`~gfe_opt.sensitivity.eigen_derivatives`) with ∂K, ∂M (and, for a shear beam,
     the observation's ∂C) from second-order differences of the *matrices* of
     ``model_at(z)`` (central; at a bound one-sided three-point, stepping inwards), no
-    modal solve besides the one of ``point``.  ``columns``: only those of z's variables
-    (the Jacobian's columns in their order).  Raises ``ValueError`` where the modes have no
+    modal solve besides the one of ``point``.  Raises ``ValueError`` where the modes have no
     derivative (a repeated or zero eigenvalue among the paired ones)."""
     from .sensitivity import eigen_derivatives
 
-    variables = np.arange(z.size) if columns is None else np.asarray(columns, dtype=int)
-    n = variables.size
+    n = z.size
     shear = point.disc.shear_g is not None and not measured.frequency_only
 
     def matrices(zz):
@@ -237,7 +235,7 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
         return K, M, (observation(disc, measured) if shear else None)
 
     dK, dM, dC = [], [], []
-    for k in variables:
+    for k in range(n):
         h = step * max(1.0, abs(z[k]))
         up, down = z.copy(), z.copy()
         if z[k] + h <= upper[k] and z[k] - h >= lower[k]:
@@ -508,18 +506,16 @@ class Objective:
         point = self.point(z)
         return np.full(self.measured.n_values, FAILED_RESIDUAL) if point is None else point.r
 
-    def _analytic(self, z, r, lower, upper, columns=None) -> np.ndarray:
+    def _analytic(self, z, r, lower, upper) -> np.ndarray:
         point = self.point(z)
         if point is not None:
             try:
                 return point_jacobian(point, np.asarray(z, dtype=float), self.model_at,
-                                      self.measured, self.noise, lower, upper,
-                                      columns=columns)
+                                      self.measured, self.noise, lower, upper)
             except _TRIAL_ERRORS:
                 pass
         self.fallbacks += 1
-        J = _difference_jacobian(self, z, r, lower, upper)
-        return J if columns is None else J[:, columns]
+        return _difference_jacobian(self, z, r, lower, upper)
 
 
 @dataclass
@@ -851,19 +847,15 @@ def _profile_starts(residual, chi2, z0, grids, slots, lower, upper, nulls=None) 
     return out[:PROFILE_STARTS]
 
 
-def _held_steps(residual, points, free, lower, upper, columns=False,
-                steps=PROFILE_STEPS) -> list:
-    """At each of ``points``, ``steps`` Gauss-Newton steps on the variables ``free`` (the
-    others held): [(χ², z)] each.  ``columns``: the analytic Jacobian of the free variables
-    alone (else all of it, the free columns taken)."""
+def _held_steps(residual, points, free, lower, upper) -> list:
+    """At each of ``points``, :data:`PROFILE_STEPS` Gauss-Newton steps on the variables
+    ``free`` (the others held): [(χ², z)] each."""
     found = []
     for z in points:
         z = np.array(z, dtype=float)
         r = residual(z)
-        for _ in range(steps):
-            if getattr(residual, "jacobian", None) is not None and columns:
-                J = residual.jacobian(z, r, lower, upper, columns=free)
-            elif getattr(residual, "jacobian", None) is not None:
+        for _ in range(PROFILE_STEPS):
+            if getattr(residual, "jacobian", None) is not None:
                 J = residual.jacobian(z, r, lower, upper)[:, free]
             else:
                 J = np.empty((r.size, len(free)))
@@ -883,12 +875,6 @@ def _held_steps(residual, points, free, lower, upper, columns=False,
     return found
 
 
-#: Gauss-Newton steps on the other variables at each point of a zone's edge tried (one step
-#: costs 0.14 s less on the 46-element demo beam's diagnosis, 2.2 s instead of 2.36 s serial;
-#: the campaigns judged three, as the profile starts take)
-EDGE_STEPS = PROFILE_STEPS
-
-
 def _edge_valley(problem, chi2, z, n_res, max_iter):
     """The fit again from the best of its effects' edges tried along the structure
     (:meth:`FitProblem.edge_scans`, the other variables fitted a few steps at each) when
@@ -903,8 +889,7 @@ def _edge_valley(problem, chi2, z, n_res, max_iter):
     found = []
     for point, held in scans:
         free = np.setdiff1d(np.arange(z.size), held)
-        found += _held_steps(residual, [point], free, lower, upper, columns=True,
-                             steps=EDGE_STEPS)
+        found += _held_steps(residual, [point], free, lower, upper)
     best_value, start = found[lowest([v for v, _ in found])]
     if not best_value < value - FINISH_SETTLED * floor:
         return None
