@@ -746,9 +746,8 @@ def refit_edges(model: Model, measured: MeasuredModes, fit: Fit, *, noise: Noise
     The end left behind is one of the new fit's ``equivalent`` when it fits as well
     (:data:`ALIKE_CHI2`)."""
     n = len(model.effects)
-    if not fit.success or not any(type(effect_type(e.name)).edge_scan is not
-                                  EffectType.edge_scan for e in fit.effects[n:]):
-        return fit    # nothing added, or nothing added with an edge
+    if not fit.success or len(fit.effects) <= n:
+        return fit
     problem = fit_problem(model.with_effects(fit.effects[:n], check=False), measured,
                           [Effect(e.name, e.parameters) for e in fit.effects[n:]], noise=noise)
 
@@ -763,8 +762,10 @@ def refit_edges(model: Model, measured: MeasuredModes, fit: Fit, *, noise: Noise
     def chi2(zz):
         return float(np.sum(residual(zz) ** 2))
 
+    value = chi2(z)
     n_res = measured.n_values
-    other = _edge_valley(problem, chi2, z, n_res, max_iter)
+    floor = max(1.0, value / max(n_res - z.size, 1))
+    other = _edge_valley(problem, chi2, z, value, floor, max_iter)
     if other is None:
         return fit
     new, new_value = problem.canonical(other[0]), other[1]
@@ -875,16 +876,14 @@ def _held_steps(residual, points, free, lower, upper) -> list:
     return found
 
 
-def _edge_valley(problem, chi2, z, n_res, max_iter):
+def _edge_valley(problem, chi2, z, value, floor, max_iter):
     """The fit again from the best of its effects' edges tried along the structure
     (:meth:`FitProblem.edge_scans`, the other variables fitted a few steps at each) when
-    that point already lies below the fit's end ``z`` (``n_res`` residuals): the end of
-    that fit when it converged lower by more than the finish's own margin, else None."""
+    that point already lies below the end ``(z, value)``: the end of that fit when it
+    converged lower by more than the finish's own margin, else None."""
     scans = problem.edge_scans(z)
     if not scans:
         return None
-    value = chi2(z)
-    floor = max(1.0, value / max(n_res - z.size, 1))
     residual, lower, upper = problem.residual, problem.lower, problem.upper
     found = []
     for point, held in scans:
