@@ -90,7 +90,6 @@ from .fitting import (
     misfit,
     noise_of,
     ranked,
-    refit_edges,
     residuals,
     slots_for,
 )
@@ -402,11 +401,6 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
                 fits[i] = fit
                 if _preferred(fit, best):
                     best = fit
-    # a zone's edges along the structure: the valley its Newton path missed (refit_edges)
-    refined = refit_edges(model, measured, best, noise=noise)
-    if refined is not best:
-        fits = [refined if f is best else f for f in fits]
-        best = refined
     if extra:
         best.added = len(model.effects) + len(extra)
     if model.kind == "frame":   # each place of the frame is a group of its own

@@ -571,22 +571,6 @@ class FitProblem:
         z = np.clip(self._per_slot(z, one), self.lower, self.upper)
         return z if moved else None
 
-    def edge_scans(self, z) -> list:
-        """Each added effect's edges tried along the structure
-        (:meth:`EffectType.edge_scan`), the other variables as in ``z``:
-        ``[(z_point, held)]``, ``held`` the indices (in ``z``) of the variables the point
-        places."""
-        out, i = [], 0
-        for slot in self.slots:
-            k = len(slot.variables)
-            for point, held in (slot.effect.edge_scan(self.base, slot.variables, z[i:i + k])
-                                if k and slot.added else ()):
-                full = np.array(z, dtype=float)
-                full[i:i + k] = point
-                out.append((np.clip(full, self.lower, self.upper), [i + h for h in held]))
-            i += k
-        return out
-
     def _per_slot(self, z, fn) -> np.ndarray:
         z = np.array(z, dtype=float)
         i = 0
@@ -636,7 +620,8 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     ``jacobian``: ``"analytic"`` (eigen-derivatives, :func:`point_jacobian`) or
     ``"difference"`` (of the modal solves); default :data:`JACOBIAN`."""
     problem = fit_problem(model, measured, adding, noise=noise, C=C, jacobian=jacobian)
-    base, slots, residual = problem.base, problem.slots, problem.residual
+    base, slots, residual, effects_of = (problem.base, problem.slots, problem.residual,
+                                         problem.effects_of)
     lower, upper, C = problem.lower, problem.upper, problem.residual.C
     n_res = measured.n_values
 
@@ -712,73 +697,20 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
             if (other[1] - value < ALIKE_CHI2 * floor and np.max(np.abs(other[0] - z)) > 0.05
                     and all(np.max(np.abs(other[0] - e)) > 0.05 for e in equivalent)):
                 equivalent.append(other[0])
-    return _fit_at(problem, measured, noise, z, status, success, equivalent, name)
-
-
-def _fit_at(problem, measured, noise, z, status, success, equivalent, name,
-            evaluations=0) -> Fit:
-    """The :class:`Fit` of ``problem`` ended at ``z``: its model, misfit and σ
-    (``equivalent``: the variables of other ends that fit as well)."""
-    base, slots, residual = problem.base, problem.slots, problem.residual
-    effects = problem.effects_of(z)
+    effects = effects_of(z)
     fitted = base.with_effects(effects, check=False)
-    fit_misfit = misfit(fitted, measured, noise, residual.C)
-    saturated = _saturated(slots, z, problem.lower, problem.upper)
+    fit_misfit = misfit(fitted, measured, noise, C)
+    saturated = _saturated(slots, z, lower, upper)
     sigma, unidentified, traded, told = _uncertainty(residual, z, slots, base, fit_misfit,
-                                                     problem.lower, problem.upper, saturated)
+                                                     lower, upper, saturated)
     added = [i for i, s in enumerate(slots) if s.added]
     return Fit(name=name or (slots[added[0]].effect.name if added else "baseline"),
                effects=tuple(effects), sigma=tuple(sigma), added=added[0] if added else None,
                model=fitted, misfit=fit_misfit, n_params=z.size, status=status,
-               success=success and np.isfinite(fit_misfit.chi2),
-               evaluations=evaluations + residual.count,
-               equivalent=[tuple(problem.effects_of(e)) for e in equivalent],
+               success=success and np.isfinite(fit_misfit.chi2), evaluations=residual.count,
+               equivalent=[tuple(effects_of(e)) for e in equivalent],
                unidentified=unidentified, traded=traded, told=tuple(told),
                bounds=tuple(saturated))
-
-
-def refit_edges(model: Model, measured: MeasuredModes, fit: Fit, *, noise: Noise,
-                max_iter: int = 25) -> Fit:
-    """``fit`` (of ``model``'s effects and the ones it added) again from the best point of
-    its added effects' edges tried along the structure (:func:`_edge_valley`: a zone's χ²
-    ripples along a member, and the Newton path picks one valley of several); the new end
-    when it converged lower by more than the finish's own margin, else ``fit`` itself.
-    The end left behind is one of the new fit's ``equivalent`` when it fits as well
-    (:data:`ALIKE_CHI2`)."""
-    n = len(model.effects)
-    if not fit.success or len(fit.effects) <= n:
-        return fit
-    problem = fit_problem(model.with_effects(fit.effects[:n], check=False), measured,
-                          [Effect(e.name, e.parameters) for e in fit.effects[n:]], noise=noise)
-
-    def variables_of(effects):
-        return np.concatenate([s.effect.to_variables(problem.base, s.variables, e.parameters)
-                               if s.variables else np.zeros(0)
-                               for s, e in zip(problem.slots, effects)])
-
-    z = problem.canonical(variables_of(fit.effects))
-    residual = problem.residual
-
-    def chi2(zz):
-        return float(np.sum(residual(zz) ** 2))
-
-    value = chi2(z)
-    n_res = measured.n_values
-    floor = max(1.0, value / max(n_res - z.size, 1))
-    other = _edge_valley(problem, chi2, z, value, floor, max_iter)
-    if other is None:
-        return fit
-    new, new_value = problem.canonical(other[0]), other[1]
-    floor = max(1.0, new_value / max(n_res - z.size, 1))
-    equivalent = []
-    for e in [z, *(variables_of(effects) for effects in fit.equivalent)]:
-        if (chi2(e) - new_value < ALIKE_CHI2 * floor and np.max(np.abs(e - new)) > 0.05
-                and all(np.max(np.abs(e - q)) > 0.05 for q in equivalent)):
-            equivalent.append(e)
-    out = _fit_at(problem, measured, noise, new, other[2], other[3], equivalent, fit.name,
-                  evaluations=fit.evaluations)
-    out.added = fit.added
-    return out
 
 
 #: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
@@ -834,9 +766,30 @@ def _profile_starts(residual, chi2, z0, grids, slots, lower, upper, nulls=None) 
     if len(points) > PROFILE_GRID_LIMIT:
         return []
     null = _null_points(points, nulls)
-    found = _held_steps(residual, [np.concatenate([z0[inner], point])
-                                   for j, point in enumerate(points)
-                                   if not (null[j] and null[:j].any())], inner, lower, upper)
+    found = []
+    for j, point in enumerate(points):
+        if null[j] and null[:j].any():
+            continue
+        z = np.concatenate([z0[inner], point])
+        r = residual(z)
+        for _ in range(PROFILE_STEPS):
+            if getattr(residual, "jacobian", None) is not None:
+                J = residual.jacobian(z, r, lower, upper)[:, inner]
+            else:
+                J = np.empty((r.size, inner.size))
+                for k in inner:
+                    dz = z.copy()
+                    h = 1e-6 * max(1.0, abs(z[k]))
+                    dz[k] += h
+                    J[:, k] = (residual(dz) - r) / h
+            step = np.linalg.lstsq(J, -r, rcond=None)[0]
+            trial = z.copy()
+            trial[inner] = np.clip(z[inner] + step, lower[inner], upper[inner])
+            r_trial = residual(trial)
+            if r_trial @ r_trial >= r @ r:
+                break
+            z, r = trial, r_trial
+        found.append((float(r @ r), z))
     # distinct starts (ends that are the same point to rounding: the first)
     out, seen = [], []
     for i in ranked([value for value, _ in found]):
@@ -846,54 +799,6 @@ def _profile_starts(residual, chi2, z0, grids, slots, lower, upper, nulls=None) 
         seen.append(value)
         out.append(found[i][1])
     return out[:PROFILE_STARTS]
-
-
-def _held_steps(residual, points, free, lower, upper) -> list:
-    """At each of ``points``, :data:`PROFILE_STEPS` Gauss-Newton steps on the variables
-    ``free`` (the others held): [(χ², z)] each."""
-    found = []
-    for z in points:
-        z = np.array(z, dtype=float)
-        r = residual(z)
-        for _ in range(PROFILE_STEPS):
-            if getattr(residual, "jacobian", None) is not None:
-                J = residual.jacobian(z, r, lower, upper)[:, free]
-            else:
-                J = np.empty((r.size, len(free)))
-                for c, k in enumerate(free):
-                    dz = z.copy()
-                    h = 1e-6 * max(1.0, abs(z[k]))
-                    dz[k] += h
-                    J[:, c] = (residual(dz) - r) / h
-            step = np.linalg.lstsq(J, -r, rcond=None)[0]
-            trial = z.copy()
-            trial[free] = np.clip(z[free] + step, lower[free], upper[free])
-            r_trial = residual(trial)
-            if r_trial @ r_trial >= r @ r:
-                break
-            z, r = trial, r_trial
-        found.append((float(r @ r), z))
-    return found
-
-
-def _edge_valley(problem, chi2, z, value, floor, max_iter):
-    """The fit again from the best of its effects' edges tried along the structure
-    (:meth:`FitProblem.edge_scans`, the other variables fitted a few steps at each) when
-    that point already lies below the end ``(z, value)``: the end of that fit when it
-    converged lower by more than the finish's own margin, else None."""
-    scans = problem.edge_scans(z)
-    if not scans:
-        return None
-    residual, lower, upper = problem.residual, problem.lower, problem.upper
-    found = []
-    for point, held in scans:
-        free = np.setdiff1d(np.arange(z.size), held)
-        found += _held_steps(residual, [point], free, lower, upper)
-    best_value, start = found[lowest([v for v, _ in found])]
-    if not best_value < value - FINISH_SETTLED * floor:
-        return None
-    other = _minimise(residual, chi2, start, lower, upper, max_iter)
-    return other if other[3] and other[1] < value - FINISH_SETTLED * floor else None
 
 
 def _minimise(residual, chi2, z_start, lower, upper, max_iter):

@@ -429,13 +429,6 @@ class EffectType:
         there is no such edge (the default)."""
         return None
 
-    def edge_scan(self, model, variables: list[Variable], z) -> list:
-        """Points along the effect's free edges where a fit that ended at ``z`` may have a
-        lower valley (a zone's edge: the modes' strain energy ripples along a member, and the
-        Newton path picks one valley of several): ``[(z_point, held)]``, ``held`` the
-        indices of the variables the point places (default: none)."""
-        return []
-
     def to_variables(self, model, variables: list[Variable], params: dict) -> np.ndarray:
         out = []
         for v in variables:

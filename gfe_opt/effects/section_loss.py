@@ -36,11 +36,6 @@ def _on_ends(variables, z):
 PAST_END = 0.05
 
 
-#: where a zone's edge is tried along the structure (:meth:`SectionLoss.edge_scan`): the
-#: length grid's own step (:data:`PAST_END`)
-EDGE_GRID = PAST_END
-
-
 #: on a frame, a zone from each end of a member (a haunch, a corroded foot) is one more
 #: start, this fraction of the member long: the grid's zones (0.05 of it) lie inside, and
 #: IPOPT stopped short of an end when the zone reaches it (the residual's kink there)
@@ -199,34 +194,6 @@ class SectionLoss(EffectType):
         z = np.array(z, dtype=float)
         z[i], z[j] = (a + b) / 2, b - a
         return z
-
-    def edge_scan(self, model, variables, z):
-        """Each free edge of the zone at every :data:`EDGE_GRID` of the length where the
-        zone stays at least its shortest, the other edge where it is (an edge on an end:
-        past it, :data:`PAST_END`).  Along a member the χ² of a zone's edge ripples with the
-        modes' strain energy: a zone on the tapered column of the frame campaign's
-        taper-4202 had valleys with its inner edge at 0.032, 0.096 and 0.165 m (χ² 172.7,
-        175.1, 191.6), and which one the fit ended in turned on the last bits of the data
-        (the diagnosis with it)."""
-        ends = _on_ends(variables, z)
-        if ends is None or (ends[2] and ends[3]):
-            return []    # held, or over the whole structure: no edge
-        i, j, at_left, at_right = ends
-        a, b = z[i] - z[j] / 2, z[i] + z[j] / 2
-        a, b = (-PAST_END if at_left else a), (1 + PAST_END if at_right else b)
-        shortest = variables[j].lower
-        grid = np.arange(1, round(1 / EDGE_GRID)) * EDGE_GRID
-        points = []
-        if not at_left:   # the left edge moves, the right stays
-            points += [(e, b) for e in grid if e <= b - shortest and b - e <= 1.0]
-        if not at_right:
-            points += [(a, e) for e in grid if e >= a + shortest and e - a <= 1.0]
-        out = []
-        for lo, hi in points:
-            point = np.array(z, dtype=float)
-            point[i], point[j] = (lo + hi) / 2, hi - lo
-            out.append((point, (i, j)))
-        return out
 
     def frame_placeholders(self, model, params):
         span = model.member_length(model.member(params["member"]))
