@@ -1143,7 +1143,10 @@ def _assemble(mesh: FrameMesh, which: str, values) -> sp.csr_matrix:
         n = mesh.n_dof
         unique, slot = np.unique(rows * n + cols, return_inverse=True)
         indptr = np.searchsorted(unique // n, np.arange(n + 1))
-        pattern = (indptr, unique % n, slot, unique.size)
+        # the index type scipy keeps them in (int32 below 2³¹ entries): it then neither
+        # scans nor copies them at every evaluation (the same matrix)
+        index = np.int32 if unique.size < 2**31 - 1 and n < 2**31 - 1 else np.int64
+        pattern = (indptr.astype(index), (unique % n).astype(index), slot, unique.size)
         mesh.patterns[which] = pattern
     indptr, indices, slot, size = pattern
     data = np.bincount(slot, weights=values, minlength=size)
