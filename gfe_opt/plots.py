@@ -60,6 +60,7 @@ def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pin
     else:
         ax, sketch = fig.add_subplot(), None
     _profile_panel(ax, band, label)
+    _legend_below(fig, ax)
     ax.set_title("Bending stiffness read from the test at each node, over the model's",
                  fontsize=10)
     if sketch is not None:
@@ -82,15 +83,23 @@ def frame_profiles(band, label=None):
     for row, (member, start, b, _) in zip(axes, bending):
         a, e = ends.get(member, (start, "?"))
         for ax, what, part in ((row[0], "EI", b), (row[1], "EA", axial[member][2])):
-            _profile_panel(ax, part, label, legend=ax is axes[0][0], quantity=what)
+            _profile_panel(ax, part, label, quantity=what)
             ax.set_title(f"{member}: {what}, from node {a} to node {e}", fontsize=9)
             ax.set_xlabel(f"distance from node {a} [m]", fontsize=8)
+    _legend_below(fig, axes[0][0])
     fig.suptitle("Bending (EI) and axial (EA) stiffness read from the test at each node of "
                  "each member, over the model's", fontsize=10)
     return fig
 
 
-def _profile_panel(ax, band, label, legend=True, quantity="EI"):
+def _legend_below(fig, ax):
+    """``ax``'s legend under the figure, where it covers no curve and no label (inside the
+    axes it covered the labels of the deepest features)."""
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=3,
+               fontsize=7, frameon=False)
+
+
+def _profile_panel(ax, band, label, quantity="EI"):
     """k_i / k_i0 (``quantity`` "EA": EA_i / EA_i0) of one
     :class:`~gfe_opt.realisation.ProfileBand` on ``ax``."""
     from .realisation import COLLAPSED
@@ -117,8 +126,6 @@ def _profile_panel(ax, band, label, legend=True, quantity="EI"):
     ax.margins(y=0.12)
     ax.set_ylabel("$k_i / k_{i,0}$ (1 = as modelled)" if quantity == "EI" else
                   "$EA_i / EA_{i,0}$ (1 = as modelled)")
-    if legend:
-        ax.legend(fontsize=7, loc="lower right")
 
 
 def disturbance_function(x_nodes, q_identified, x_fine, q_exact, *, label_exact: str):
