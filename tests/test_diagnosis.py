@@ -197,3 +197,36 @@ def test_unexplained_with_white_residuals_at_more_noise_than_stated_says_so():
                    for n in _noise_notes(far, "unexplained", measured))
     assert not any("noise larger than stated" in n
                    for n in _noise_notes(white_est, "effect_found", measured))
+
+
+def test_a_profile_the_information_criterion_prefers_over_the_explaining_pair_is_a_close_call():
+    """When the pair that explains is chosen over a free profile that fits better with fewer
+    parameters but not significantly better, the two criteria the diagnosis uses (the
+    significance test and the Bayesian information criterion χ²/s² + p ln n) disagree: the
+    note says so with both numbers (the drop in χ² and what significance asks, the
+    quantile of χ² at the profile's own α) and the ``--add`` that models the profile on its
+    member.  A profile the criterion ranks below the pair (as many parameters more as its
+    drop does not pay for), or that fits worse, gives no note."""
+    from types import SimpleNamespace
+
+    from scipy.special import chdtri
+
+    from gfe_opt.diagnosis import _close_profile, _Selection
+    from gfe_opt.fitting import Misfit
+
+    def fit(name, chi2, p, parameters=None):
+        return SimpleNamespace(name=name, misfit=Misfit(chi2, 0.1, 0.99, 108), n_params=p,
+                               success=True, failed=False, parameters=parameters or {})
+
+    sel = _Selection(reference_chi2=5000.0, reference_params=0, n_candidates=12, n_modes=6,
+                     floor=1.0)
+    pair = fit("crack", 91.4, 6)
+    profile = fit("stiffness_profile", 76.6, 2, {"member": "left-column", "x": [0.0, 0.3]})
+    needed = float(chdtri(1, sel.alpha("stiffness_profile")))
+    assert 14.8 < needed   # not significantly better: the pair is the finding
+    (note,) = _close_profile(profile, pair, sel)
+    assert "close call" in note and "14.8" in note and f"{needed:.3g}" in note
+    assert "--add stiffness_profile:member=left-column,x=0;0.3" in note
+    # 9 parameters for 0.5 lower: 3 ln 108 = 14 more in the criterion than the drop pays
+    assert _close_profile(fit("stiffness_profile", 90.9, 9), pair, sel) == []
+    assert _close_profile(fit("stiffness_profile", 92.0, 2), pair, sel) == []
