@@ -21,7 +21,7 @@ Effects do not touch matrices themselves: each tells a :class:`Builder` what it 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import Callable
 
 import numpy as np
@@ -71,9 +71,13 @@ class Discretisation:
     def n_dof(self) -> int:
         return self.dofs_per_node * len(self.nodes)
 
-    @property
+    @cached_property
     def free(self) -> np.ndarray:
-        return np.setdiff1d(np.arange(self.n_dof), self.constrained)
+        """The unconstrained DOFs (read-only; kept: the modal solve, the observation and the
+        eigen-derivatives ask for them at every evaluation)."""
+        free = np.setdiff1d(np.arange(self.n_dof), self.constrained)
+        free.flags.writeable = False
+        return free
 
     def element_dofs(self) -> np.ndarray:
         """(n_elements, 2 n) global DOF indices of each element."""

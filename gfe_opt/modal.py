@@ -75,7 +75,7 @@ class Modes:
 
 
 def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | None = None,
-                roundoff_fraction: float = 1e-8, dense: bool | None = None):
+                roundoff_fraction: float = 1e-8, dense: bool | None = None, free=None):
     """Lowest ``n_modes`` eigenpairs of the sparse pencil (K, M) with DOFs ``constrained`` fixed.
 
     Returns :class:`Modes` with shapes expanded to all DOFs (zeros at constrained ones),
@@ -87,7 +87,8 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     :data:`DENSE_LIMIT` free DOFs).
     """
     n = K.shape[0]
-    free = np.setdiff1d(np.arange(n), np.asarray(constrained, dtype=int))
+    if free is None:   # (given: the DOFs not in ``constrained``, as a discretisation keeps)
+        free = np.setdiff1d(np.arange(n), np.asarray(constrained, dtype=int))
     if n_modes < 1 or n_modes > len(free) - 1:
         raise ValueError(f"n_modes must lie in [1, {len(free) - 1}], got {n_modes}")
     dense = len(free) <= DENSE_LIMIT if dense is None else dense
@@ -190,7 +191,7 @@ def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
         return _condensed_modes(disc, n_modes, params)
     K, M = disc.global_matrices(params) if matrices is None else matrices
     modes = solve_modes(K, M, n_modes, disc.constrained, disc.eigenvalue_scale,
-                        dense=getattr(disc, "dense_solve", None))
+                        dense=getattr(disc, "dense_solve", None), free=disc.free)
     lam = _rayleigh(disc, modes.shapes, params, M)
     worst = _residual(K, M, modes.shapes, lam, disc.free)
     if worst > RESIDUAL_TOLERANCE:
