@@ -375,6 +375,18 @@ def _size(model, effect: Effect):
                                                              p.get("shear_rigidity")))))
 
 
+def perturbed(case: dict, eps: float) -> dict:
+    """``case`` with its measured frequencies and shape values each multiplied by
+    1 + ``eps`` × a normal draw (seeded by the case's name; ``bench_diagnosis.perturbed``)."""
+    m = case["measured"]
+    rng = np.random.default_rng(list(case["name"].encode()))
+
+    def scaled(a):
+        return None if a is None else a * (1 + eps * rng.standard_normal(a.shape))
+    return {**case, "measured": replace(m, frequencies_hz=scaled(m.frequencies_hz),
+                                        shapes=scaled(m.shapes))}
+
+
 def run_case(case: dict) -> dict:
     model, measured, noise = case["model"], case["measured"], case["noise"]
     said = []
@@ -460,6 +472,10 @@ def main(argv=None) -> int:
     ap.add_argument("--json", help="write the document to this file too")
     ap.add_argument("--classes", help="comma-separated classes to run (default: all); each "
                     "case keeps the seed it has in the full campaign")
+    ap.add_argument("--perturb", type=float, default=0.0, metavar="EPS",
+                    help="multiply every measured frequency and shape value by 1 + EPS times "
+                    "a normal draw (seeded by the case), e.g. 1e-9: which decisions hinge on "
+                    "rounding, on one machine")
     args = ap.parse_args(argv)
     diagnosis.SERIAL_FITS = True    # one core per campaign: run seeds side by side
     rows = []
@@ -472,6 +488,8 @@ def main(argv=None) -> int:
     for n, (seed, group) in enumerate(seeds, start=1):
         start = time.perf_counter()
         case = make_case(seed, group)
+        if args.perturb:
+            case = perturbed(case, args.perturb)
         try:
             row = run_case(case)
         except Exception as exc:     # scored as wrong, the campaign goes on
