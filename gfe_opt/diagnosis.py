@@ -1136,11 +1136,11 @@ def _profile_argument(profile) -> str:
 
 def _close_profile(profile, pair, sel) -> list[str]:
     """A note when the free ``profile`` that does not explain significantly more than the
-    explaining ``pair`` still ranks above it by the information criterion (fewer parameters
-    for nearly as much): the two criteria the diagnosis uses disagree, so the choice of the
-    pair is a close call the user is told of (the frame campaign's taper-4202, a tapered
-    column: its profile's χ² 14.8 below a section loss with a crack's, 18.3 asked; which
-    side it fell on turned on rounding)."""
+    explaining ``pair`` fits better and ranks above it by the information criterion (its
+    drop in χ² pays for its parameters): the two criteria the diagnosis uses disagree, so
+    the choice of the pair is a close call the user is told of (the frame campaign's
+    taper-4202, a tapered column: its profile's χ² 14.8 below a section loss with a
+    crack's, 18.3 asked; which side it fell on turned on rounding)."""
     if (not profile.success or profile.failed or profile.misfit.chi2 >= pair.misfit.chi2
             or sel.penalised(profile) >= sel.penalised(pair)):
         return []
@@ -1150,8 +1150,8 @@ def _close_profile(profile, pair, sel) -> list[str]:
             f"{pair.misfit.chi2_per_residual:.3g}, {profile.n_params} parameters against "
             f"{pair.n_params}) ranks above the pair by the information criterion, though it "
             f"lowers χ² by {pair.misfit.chi2 - profile.misfit.chi2:.3g}, less than the "
-            f"{needed:.3g} that significantly more asks; a change spread along the structure "
-            f"is as likely (to compare: gfe-opt update MODEL MEASURED --add "
+            f"{needed:.3g} that significantly more asks; the structure may differ by a "
+            f"change spread along it instead (to compare: gfe-opt update MODEL MEASURED --add "
             f"{_profile_argument(profile)})"]
 
 
