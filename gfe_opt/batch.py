@@ -149,16 +149,12 @@ def sweep_temp(root=None) -> int:
 def _solve(task: Task, model_path: Path, measured_path: Path, name: str) -> dict:
     from .diagnosis import diagnose, update
     from .effects import effect_type
-    from .measured import load_measured
     from .model import load_model
+    from .structure import structure
 
     model = load_model(model_path, frames=True)
-    if model.kind == "frame":
-        from .frame_data import load_frame_measured
-
-        measured = load_frame_measured(measured_path, model)
-    else:
-        measured = load_measured(measured_path)
+    # (a CSV's translations read as the model's: a bar's u; before, always a beam's w)
+    measured = structure(model).load_measured(measured_path)
     out = {"label": measured.label, "time": None if measured.time is None
            else str(measured.time)}
     if task.add:

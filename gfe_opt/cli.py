@@ -257,15 +257,11 @@ def _comparison_report(report, result, model, measured):
 def _inputs(args, frames: bool = False):
     """The model and measured files of a command (input errors before any solver loads);
     ``frames``: the command takes a plane frame too."""
-    from .measured import load_measured
     from .model import load_model
+    from .structure import structure
 
     model = load_model(args.model, frames=frames)
-    if model.kind == "frame":
-        from .frame_data import load_frame_measured
-
-        return model, load_frame_measured(args.measured, model)
-    return model, load_measured(args.measured, dof="w" if model.kind == "beam" else "u")
+    return model, structure(model).load_measured(args.measured)
 
 
 def cmd_compare(args) -> int:

@@ -71,7 +71,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import chdtri, ndtri
 
-from .correlation import check_model_size, check_units, compare
 from .effects import candidate_names, effect_type
 from .errors import GfeInputError, GfeSolverError
 from .fitting import (
@@ -93,8 +92,9 @@ from .fitting import (
     residuals,
     slots_for,
 )
-from .measured import MeasuredModes, on_model, sensor_matrix
-from .model import Effect, Model, check_repeats, parse_effect
+from .measured import MeasuredModes
+from .model import Effect, Model, parse_effect
+from .structure import GENERIC_FAILURES, structure
 
 __all__ = ["DEFAULT_FREQ_NOISE", "DEFAULT_SHAPE_NOISE", "Diagnosis", "UpdateOutcome",
            "diagnose", "parse_effect", "update"]
@@ -157,7 +157,7 @@ def sparse_shapes(model: Model) -> bool:
     semi-rigid portal's 14 sensors: a one-joint fit 8 % off in frequency has white
     residuals, z = 2.6).  There the frequencies must also lie within
     :data:`FREQ_NOISE_LIMIT` of the assumed noise, as for a test of frequencies alone."""
-    return model.kind == "frame"
+    return structure(model).sparse_shapes
 
 
 def looks_like_noise(model: Model, m: Misfit, correlation: float, measured) -> bool:
@@ -181,22 +181,16 @@ def shape_correlation(model: Model, measured: MeasuredModes, noise: Noise, C=Non
     if r is None:
         return 1.0
     shapes = r.reshape(measured.n_modes, -1)[:, 1:]
-    frame = model.kind == "frame"
-    if frame:
-        from .frame_data import neighbour_pairs
-
-        a, b = neighbour_pairs(model, measured.sensors)
-        if a.size == 0:
-            return 0.0
-    else:   # along the beam
-        shapes = shapes[:, np.argsort(measured.x)]
+    order, a, b = structure(model).neighbours(measured)
+    if a.size == 0:
+        return 0.0
+    if order is not None:   # along the structure
+        shapes = shapes[:, order]
     if shapes.shape[1] < 3:
         return 0.0
     shapes = shapes - shapes.mean(axis=1, keepdims=True)
     den = float(np.sum(shapes**2))
-    # a beam's neighbours as slices (the sums in the order they always had)
-    products = shapes[:, a] * shapes[:, b] if frame else shapes[:, 1:] * shapes[:, :-1]
-    return float(np.sum(products) / den) if den > 0 else 0.0
+    return float(np.sum(shapes[:, a] * shapes[:, b]) / den) if den > 0 else 0.0
 
 
 # -------------------------------------------------------------------------------------------
@@ -272,7 +266,7 @@ class Diagnosis:
         (``joint_spring:node=C,member=beam``): a place is chosen, not fitted, and naming it
         spares ``update`` the search over every place."""
         fit = self.together if self.together is not None else self.best
-        if not self.suggested or fit is None or fit.model.kind != "frame":
+        if not self.suggested or fit is None or not structure(fit.model).discrete_places:
             return list(self.suggested)
         out = []
         for e in fit.effects[len(fit.effects) - len(self.suggested):]:
@@ -383,7 +377,8 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
     for fit in fits[1:]:
         if _preferred(fit, best):
             best = fit
-    if model.kind == "frame" and not extra:
+    places = structure(model).discrete_places
+    if places and not extra:
         source, member = best, (given or {}).get("member")
         along = any(p.name == "position" for p in kind.parameters)   # a place on it
         if member is not None and along and "position" not in given:
@@ -403,7 +398,7 @@ def _fit_candidate(model, measured, name, noise, hint, given=None, extra=(), see
                     best = fit
     if extra:
         best.added = len(model.effects) + len(extra)
-    if model.kind == "frame":   # each place of the frame is a group of its own
+    if places:   # each place (a frame's member or joint) is a group of its own
         best.other_places = [(f.effects, f.misfit.chi2) for f in fits
                              if f is not best and f.success]
     return best
@@ -447,7 +442,7 @@ def _group_jobs(jobs):
     and for each the index of the job it came from."""
     out, owner = [], []
     for i, (kind, payload) in enumerate(jobs):
-        if kind != "candidate" or payload[0].kind != "frame":
+        if kind != "candidate" or not structure(payload[0]).discrete_places:
             out.append((kind, payload))
             owner.append(i)
             continue
@@ -755,15 +750,11 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     start = time.perf_counter()
     noise = noise_of(freq_noise, shape_noise)
     names = _candidates(model, candidates)
-    frame = model.kind == "frame"
-    measured, dropped = (measured, []) if frame else on_model(measured, model)
-    check_model_size(_discretise(model), measured, model.source or model.name)
-    C = None if frame else sensor_matrix(model.nodes, model.kind, measured.x, measured.dof,
-                                         measured.source)
+    shape = structure(model)
+    measured, dropped, C = shape.prepared(measured)
     baseline = misfit(model, measured, noise, C)
-    places = failure_places(model, measured, noise)
-    # where along the beam the model fails, x / L (a frame's effects start on every member)
-    hint = 0.5 if frame or not places else places[0][0] / model.length
+    places = shape.failure_places(measured, noise)
+    hint = shape.hint(places)   # where the model fails, x / L
     reference = (fit_effects(model, measured, [], noise=noise, C=C)
                  if slots_for(model, []) and any(s.variables for s in slots_for(model, []))
                  else None)
@@ -950,14 +941,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     failed = [f for f in fits if f.failed]
     if realise and generic is not None:
         from .realisation import describe_profile, explain
-        from .realisation import realise as realise_rows
 
-        if generic.ok and model.kind == "beam":
-            nodal = realise_rows(generic.discretisation, _discretise(model))
-        elif generic.ok and model.kind == "frame":
-            from .realisation import realise_members
-
-            nodal = realise_members(generic.discretisation, _discretise(model))
+        nodal = shape.realise(generic)
         found = ranked[0] if ranked and ranked[0].significant else None
         if band is not None and found is not None:
             from .realisation import noisy_copies
@@ -1101,9 +1086,9 @@ def _swap(model, measured, noise, reference, names, sel):
             continue
         rest = [e for j, e in enumerate(reference.effects) if j != i]
         base = model.with_effects(rest, check=False)
-        where = effect.parameters.get("position")
-        hint = where / model.length if isinstance(where, (int, float)) \
-            and model.kind != "frame" else 0.5
+        hint = structure(model).fraction(effect.parameters.get("position"),
+                                         effect.parameters.get("member"))
+        hint = 0.5 if hint is None else hint
         alts = []
         for name in names:
             other = effect_type(name)
@@ -1163,11 +1148,7 @@ def _skipped_note(skipped, measured, model) -> str:
 def failure_places(model, measured, noise) -> list:
     """Where the model fails, largest first: (x, fraction) along a beam, (sensor, fraction)
     on a frame (:meth:`~gfe_opt.frame_data.FrameComparison.failure_places`)."""
-    if model.kind == "frame":
-        from .frame_data import compare_frame
-
-        return compare_frame(model, measured).failure_places()
-    return compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
+    return structure(model).failure_places(measured, noise)
 
 
 def _discretise(model):
@@ -1200,12 +1181,10 @@ def _fallback(model, measured, noise, names, sel, band, progress, members=None):
     a frame each member (or those of ``members``) is tried."""
     chosen = None
     # a beam's profile spans it; a frame's lies along one member (each member tried)
-    spans = ([(m.id, model.member_length(m)) for m in model.members
-              if members is None or m.id in members]
-             if model.kind == "frame" else [(None, model.length)])
+    spans = structure(model).spans(members)
     # m modes determine about 2m - 1 knots of a profile; on a frame a member's share of
     # them (the modes' curvature is spread over its members)
-    per_span = measured.n_modes / (len(model.members) if model.kind == "frame" else 1)
+    per_span = measured.n_modes / len(structure(model).spans())
     for name in names:
         kind = effect_type(name)
         counts = [k for k in kind.knot_counts if k <= max(2, 2 * per_span - 1)]
@@ -1318,7 +1297,7 @@ def _generic_update(model, measured, noise):
     disc = discretise(model)
     try:
         result = update_generic(disc, measured, noise=max(noise.shape, 1e-3))
-    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+    except GENERIC_FAILURES:
         return None, None
     band = profile_band(disc, measured, result, noise) if result.ok else None
     return result, band
@@ -1327,15 +1306,10 @@ def _generic_update(model, measured, noise):
 def _generic_only(model, measured, noise):
     """The paper's generic-element update of the measured data (None if it fails; a
     frame's member by member, :mod:`gfe_opt.frame_generic`)."""
-    from .updating import update_generic
 
     try:
-        if model.kind == "frame":
-            from .frame_generic import update_frame_generic
-
-            return update_frame_generic(model, measured, noise=max(noise.shape, 1e-3))
-        return update_generic(_discretise(model), measured, noise=max(noise.shape, 1e-3))
-    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+        return structure(model).generic_update(measured, noise)
+    except GENERIC_FAILURES:
         return None
 
 
@@ -1406,7 +1380,8 @@ def _other_places(fit, measured, noise, C, sel, together=None) -> str | None:
     time, whichever fit better here.  The data cannot tell those places apart.  A place
     that the suggested pair (``together``) holds an effect of this kind at is no
     alternative: both are suggested (two semi-rigid joints)."""
-    if fit.added is None or fit.model.kind != "frame" or not fit.other_places:
+    if fit.added is None or not structure(fit.model).discrete_places \
+            or not fit.other_places:
         return None
     from .frame_data import effect_place
 
@@ -1455,8 +1430,7 @@ def _undetermined(fit, model) -> list:
     """The effect sets that fit as well as ``fit`` and are not its mirror image on a
     symmetric model (which symmetry explains): each is a reason the data do not determine
     the finding."""
-    symmetric = model.kind != "frame" and model.supports[0] == model.supports[1] and not any(
-        effect_type(e.name).local for e in model.effects)
+    symmetric = structure(model).mirror_symmetric()
     out = []
     for effects in fit.equivalent:
         if symmetric and _mirrored(fit.effects, effects, model.length):
@@ -1516,7 +1490,7 @@ def equivalent_notes(fit, measured) -> list[str]:
 def _mirror(fit, measured, noise, C, sel) -> str | None:
     """A sentence when the added local effect fits as well at its mirror image (x -> L - x):
     on a symmetric beam frequencies cannot tell the two apart."""
-    if fit.added is None or fit.model.kind == "frame":
+    if fit.added is None or structure(fit.model).discrete_places:
         return None
     model = fit.model
     added = fit.effects[fit.added]
@@ -1665,13 +1639,8 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     (their index in the model's effects, or a name the model holds once): a diagnosis's
     ``replace``."""
     noise = noise_of(freq_noise, shape_noise)
-    if model.kind == "frame":   # sensors on a frame read through its mesh, per model
-        dropped, C = [], None
-    else:
-        measured, dropped = on_model(measured, model)
-        check_model_size(_discretise(model), measured, model.source or model.name)
-        check_units(model, measured)
-        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    shape = structure(model)
+    measured, dropped, C = shape.prepared(measured, units=True)
     before = misfit(model, measured, noise, C)
     taken = []
     if drop:
@@ -1683,12 +1652,7 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     for e in effects:
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
                                      partial=True)
-    if model.kind == "frame":   # one joint spring a member end, one axial load a member
-        from .frame import check_repeats as check_frame_repeats
-
-        check_frame_repeats([*model.effects, *effects], "--add")
-    else:
-        check_repeats([*model.effects, *effects], "--add", "effects")
+    shape.check_repeats([*model.effects, *effects], "--add")
     check_enough_modes(measured, [*model.effects, *effects])
     hint = None
     starts = []
@@ -1705,17 +1669,11 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
         if getattr(kind, "fallback", False):
             starts.append(_profile_start(model, measured, e, noise))
             continue
-        if hint is None and model.kind == "frame":
-            hint = 0.5   # no effect along a frame's members is fitted yet
-        elif hint is None:
-            places = compare(model, measured, noise=max(noise.shape, 1e-3)).failure_places()
-            hint = places[0][0] / model.length if places else 0.5
-        where, member = e.parameters.get("position"), e.parameters.get("member")
-        if where is None or model.kind == "frame" and member is None:
-            along = hint
-        else:   # along the structure, or along its member on a frame
-            along = where / (model.member_length(model.member(member))
-                             if model.kind == "frame" else model.length)
+        if hint is None:   # where the model fails (a frame's effects start everywhere)
+            hint = shape.start_hint(measured, noise)
+        # along the structure, or along its member on a frame
+        along = shape.fraction(e.parameters.get("position"), e.parameters.get("member"))
+        along = hint if along is None else along
         # fitted on top of the instances added before it: a second crack finds the second
         single = _fit_candidate(model, measured, e.name, noise, along, given=e.parameters,
                                 extra=tuple(starts))
@@ -1779,7 +1737,7 @@ def drop_indices(model: Model, drop) -> set:
 def _default_fixed(kind, model):
     """Placeholder fixed parameters so that a kind can list its variables (on a frame,
     those of its first start: a place on the frame)."""
-    first = (kind.starts(model, 0.5) or [{}])[0] if model.kind == "frame" else {}
+    first = structure(model).first_place(kind)
     out = {}
     for key in kind.fixed_keys(model):
         if key in first:
@@ -1798,19 +1756,15 @@ def _profile_start(model, measured, effect, noise):
         return effect
     kind = effect_type(effect.name)
     member = effect.parameters.get("member")
-    if model.kind == "frame" and member is None:
-        raise GfeInputError("--add", effect.name, f"a {effect.name} on a frame needs its "
-                            f"member: --add {effect.name}:member=ID")
-    if model.kind == "frame" and "x" in effect.parameters:   # ratios from 1
-        x = effect.parameters["x"]
-        return Effect(effect.name, {"member": member, "x": list(x), "ratio": [1.0] * len(x)})
-    band = _generic_update(model, measured, noise)[1] if model.kind == "beam" else None
-    if "x" in effect.parameters:
+    shape = structure(model)
+    shape.check_member(effect)
+    band = shape.generic_band(measured, noise)
+    if "x" in effect.parameters:   # ratios from the generic update's reading, else 1
         x = effect.parameters["x"]
         start = kind.start_ratio(band, model, np.asarray(x)) or [1.0] * len(x)
-        return Effect(effect.name, {"x": list(x), "ratio": list(start)})
-    C = None if model.kind == "frame" else sensor_matrix(model.nodes, model.kind, measured.x,
-                                                         measured.dof, measured.source)
+        return Effect(effect.name, {**({} if member is None else {"member": member}),
+                                    "x": list(x), "ratio": list(start)})
+    C = shape.sensor_matrix(measured)
     ref = misfit(model, measured, noise, C)
     sel = _Selection(ref.chi2, 0, 1, measured.n_modes)
     chosen = _fallback(model, measured, noise, [effect.name], sel, band, None,

@@ -54,10 +54,11 @@ from .assembly import discretise
 from .correlation import mac, pair_by_frequency, pair_modes
 from .effects import EffectType, effect_type
 from .errors import GfeInputError, GfeSolverError
-from .measured import MeasuredModes, observation, sensor_matrix
+from .measured import MeasuredModes, observation
 from .modal import condensed, discretisation_modes, rigid_body_count
 from .model import Effect, Model
 from .screening import screened_chi2
+from .structure import structure
 
 DEFAULT_FREQ_NOISE = names.DEFAULT_FREQ_NOISE
 DEFAULT_SHAPE_NOISE = names.DEFAULT_FIT_SHAPE_NOISE
@@ -193,7 +194,7 @@ def point_of(disc, K, M, modes, measured, noise: Noise, C=None) -> Point:
         f_err = modes.frequencies_hz[cols] / measured.frequencies_hz[rows] - 1.0
         r[rows] = f_err / noise.freq
         return Point(r, f_err, None, disc, K, M, modes, rows, cols)
-    if C is None or disc.shear_g is not None or disc.kind == "frame":
+    if C is None or disc.shear_g is not None:   # (a frame's C is None: structure.Frame)
         C = observation(disc, measured)
     shapes = C @ modes.shapes
     mac_matrix = mac(measured.shapes, shapes)
@@ -587,8 +588,8 @@ def fit_problem(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     """The :class:`FitProblem` of :func:`fit_effects` (same arguments)."""
     base = model.with_effects([], check=False)
     slots = slots_for(model, adding)
-    if C is None and model.kind != "frame":   # a frame's: per model (evaluate)
-        C = sensor_matrix(model.nodes, model.kind, measured.x, measured.dof, measured.source)
+    if C is None:   # a frame's is None: read per model (evaluate)
+        C = structure(model).sensor_matrix(measured)
     lower = np.array([v.lower for s in slots for v in s.variables])
     upper = np.array([v.upper for s in slots for v in s.variables])
     problem = FitProblem(base, slots, lower, upper, None)

@@ -277,3 +277,32 @@ def test_a_looping_batch_ends_each_set_where_the_campaign_loop_does(tmp_path, ca
     assert main(["batch", str(model_path), str(tmp_path / "sets"), "--out",
                  str(tmp_path / "x.csv"), "--loop", "--add", "crack"]) == 2
     assert "--loop" in capsys.readouterr().err
+
+
+def test_a_bars_csv_sets_are_read_as_its_axial_motion(tmp_path, capsys):
+    """A CSV does not say its direction; ``batch`` reads a bar's sets as ``u``, as the
+    single-file commands do (it read them as a beam's ``w`` and failed every set).  The
+    set: an independent fine bar (tests/reference.py) carrying 0.1 kg at 1.2 m."""
+    from gfe_opt.measured import make_measured, save_measured
+
+    from .conftest import STEEL_BAR
+    from .reference import ReferenceBar
+
+    s = np.linspace(0.05, 2.0, 40)
+    f, y = ReferenceBar(elements=4000, point_masses=[(1.2, 0.1)]).measure(5, s, seed=4)
+    (tmp_path / "sets").mkdir()
+    save_measured(make_measured(s, "u", f, y, "bar"), tmp_path / "sets" / "a.csv")
+    model_path = tmp_path / "bar.toml"
+    model_path.write_text(tomli_w.dumps({**STEEL_BAR, "elements": 40}))
+    out = tmp_path / "bar.csv"
+    assert main(["batch", str(model_path), str(tmp_path / "sets"), "--out", str(out),
+                 "--workers", "1"]) == 0
+    row = read_table(out)[0]
+    assert row["status"] == "ok" and row["verdict"] == "effect_found", row
+    assert row["effect"] == "point_mass", row
+    assert abs(row["point_mass.position"] - 1.2) < 0.02 and abs(row["point_mass.mass"] / 0.1
+                                                                 - 1) < 0.05, row
+    capsys.readouterr()
+    assert main(["diagnose", str(model_path), str(tmp_path / "sets" / "a.csv"), "--json"]) == 0
+    single = json.loads(capsys.readouterr().out)
+    assert single["verdict"] == row["verdict"]
