@@ -438,8 +438,7 @@ def cmd_update(args) -> int:
     else:
         print(format_update(outcome))
         if args.out:
-            again = "compare" if model.kind == "frame" else "diagnose"
-            print(f"updated model written to {args.out}; continue with: gfe-opt {again} "
+            print(f"updated model written to {args.out}; continue with: gfe-opt diagnose "
                   f"{args.out} {args.measured}")
     if args.plot or args.report:
         from .report import update_figures

@@ -1068,6 +1068,13 @@ def test_cli_update_on_a_frame(tmp_path):
     doc = json.loads(run.stdout)
     assert doc["after"]["chi2_per_residual"] < 2 < doc["before"]["chi2_per_residual"]
     assert [e["effect"] for e in doc["effects"]] == ["joint_spring", "joint_spring"]
+    # in words, the next step is a diagnosis of the updated frame, as for a beam
+    text = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
+                           "joint_spring:node=B,member=beam", "--add",
+                           "joint_spring:node=C,member=beam", "--out", str(out), "--force"],
+                          capture_output=True, text=True)
+    assert text.returncode == 0, text.stderr
+    assert f"continue with: gfe-opt diagnose {out} {data}" in text.stdout
     bad = subprocess.run([sys.executable, "-m", "gfe_opt", "update", frame, data, "--add",
                           "joint_spring:node=A,member=beam"], capture_output=True, text=True)
     assert bad.returncode == 2 and "does not end at node 'A'" in bad.stderr
