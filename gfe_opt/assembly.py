@@ -75,9 +75,7 @@ class Discretisation:
     def free(self) -> np.ndarray:
         """The unconstrained DOFs (read-only; kept: the modal solve, the observation and the
         eigen-derivatives ask for them at every evaluation)."""
-        free = np.setdiff1d(np.arange(self.n_dof), self.constrained)
-        free.flags.writeable = False
-        return free
+        return free_dofs(self.n_dof, np.asarray(self.constrained, dtype=np.int64).tobytes())
 
     def element_dofs(self) -> np.ndarray:
         """(n_elements, 2 n) global DOF indices of each element."""
@@ -403,6 +401,15 @@ def builder(model: Model) -> Builder:
     for effect in model.effects:
         effect_type(effect.name).contribute(model, effect.parameters, build)
     return build
+
+
+@lru_cache(maxsize=256)
+def free_dofs(n_dof: int, constrained: bytes) -> np.ndarray:
+    """The DOFs of ``range(n_dof)`` not in ``constrained`` (int64 bytes), read-only: one
+    array for every discretisation of a mesh and its supports (a fit builds hundreds)."""
+    free = np.setdiff1d(np.arange(n_dof), np.frombuffer(constrained, dtype=np.int64))
+    free.flags.writeable = False
+    return free
 
 
 def discretise(model: Model) -> Discretisation:

@@ -31,6 +31,7 @@ Results are deterministic (dense solvers; a fixed start vector for shift-invert)
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import scipy.linalg as sla
@@ -357,15 +358,8 @@ def rigid_body_count(disc: Discretisation) -> int:
     energy (a foundation or a spring to ground takes them away)."""
     if disc.kind == "frame":
         return disc.rigid_body_count()
-    x = disc.nodes
-    if disc.kind == "beam":
-        basis = np.zeros((disc.n_dof, 2))
-        basis[0::2, 0] = 1.0
-        basis[0::2, 1], basis[1::2, 1] = x - x[0], 1.0
-    else:
-        basis = np.ones((disc.n_dof, 1))
-    fixed = basis[disc.constrained]
-    null = sla.null_space(fixed) if fixed.size else np.eye(basis.shape[1])
+    basis, null = _rigid_motions(disc.kind, np.asarray(disc.nodes, float).tobytes(),
+                                 np.asarray(disc.constrained, dtype=np.int64).tobytes())
     if null.shape[1] == 0:
         return 0
     motions = basis @ null
@@ -381,6 +375,27 @@ def rigid_body_count(disc: Discretisation) -> int:
     Mr = np.einsum("eim,eij,ejn->mn", u, disc.mass, u)
     lam = sla.eigh(0.5 * (E + E.T), Mr, eigvals_only=True)
     return int(np.sum(lam <= 1e-9 * disc.eigenvalue_scale))
+
+
+@lru_cache(maxsize=256)
+def _rigid_motions(kind: str, nodes: bytes, constrained: bytes):
+    """The rigid motions w = a + b x, θ = b (bar: u = a) of a line's nodes (float64 bytes)
+    as columns of ``basis``, and ``null``, the combinations that vanish at the constrained
+    DOFs (int64 bytes); read-only, one pair for every discretisation of a mesh and its
+    supports (a fit builds hundreds)."""
+    x = np.frombuffer(nodes, dtype=float)
+    n_dof = (2 if kind == "beam" else 1) * len(x)
+    if kind == "beam":
+        basis = np.zeros((n_dof, 2))
+        basis[0::2, 0] = 1.0
+        basis[0::2, 1], basis[1::2, 1] = x - x[0], 1.0
+    else:
+        basis = np.ones((n_dof, 1))
+    fixed = basis[np.frombuffer(constrained, dtype=np.int64)]
+    null = sla.null_space(fixed) if fixed.size else np.eye(basis.shape[1])
+    for a in (basis, null):
+        a.flags.writeable = False
+    return basis, null
 
 
 def model_modes(model: Model, n_modes: int) -> Modes:
