@@ -119,6 +119,39 @@ class Discretisation:
             energy = energy + value * shapes[dof] ** 2
         return energy
 
+    def rigid_body_count(self) -> int:
+        """How many rigid-body modes (ω = 0) the supports and springs leave: the motions
+        w = a + b x, θ = b (bar: u = a) that vanish at the constrained DOFs and store no
+        strain energy (a foundation or a spring to ground takes them away)."""
+        import scipy.linalg as sla
+
+        basis, null = _rigid_motions(self.kind, np.asarray(self.nodes, float).tobytes(),
+                                     np.asarray(self.constrained, dtype=np.int64).tobytes())
+        if null.shape[1] == 0:
+            return 0
+        motions = basis @ null
+        k = motions.shape[1]
+        # a rigid motion of the elements stores no strain energy (up to rounding): what the
+        # foundation and springs store decides; combinations count (a free beam on one
+        # spring still turns about it), so the k x k energy matrix by polarisation
+        pairs = np.stack([motions[:, i] + motions[:, j] for i in range(k) for j in range(k)],
+                         1)
+        energy = self.strain_energy(np.hstack([motions, pairs]))
+        single, both = energy[:k], energy[k:].reshape(k, k)
+        E = 0.5 * (both - single[:, None] - single[None, :])
+        u = motions[self.element_dofs()]
+        Mr = np.einsum("eim,eij,ejn->mn", u, self.mass, u)
+        lam = sla.eigh(0.5 * (E + E.T), Mr, eigvals_only=True)
+        return int(np.sum(lam <= 1e-9 * self.eigenvalue_scale))
+
+    def observation(self, measured) -> sp.csr_matrix:
+        """The sensors of ``measured`` reading the DOFs (interpolated with the elements'
+        Timoshenko g, if any: :func:`~gfe_opt.measured.sensor_matrix`)."""
+        from .measured import sensor_matrix
+
+        return sensor_matrix(self.nodes, self.kind, measured.x, measured.dof,
+                             measured.source, shear_g=self.shear_g)
+
     def with_stiffness(self, params) -> "Discretisation":
         return replace(self, stiffness_params={k: np.asarray(v, float) for k, v in params.items()})
 
@@ -401,6 +434,29 @@ def builder(model: Model) -> Builder:
     for effect in model.effects:
         effect_type(effect.name).contribute(model, effect.parameters, build)
     return build
+
+
+@lru_cache(maxsize=256)
+def _rigid_motions(kind: str, nodes: bytes, constrained: bytes):
+    """The rigid motions w = a + b x, θ = b (bar: u = a) of a line's nodes (float64 bytes)
+    as columns of ``basis``, and ``null``, the combinations that vanish at the constrained
+    DOFs (int64 bytes); read-only, one pair for every discretisation of a mesh and its
+    supports (a fit builds hundreds)."""
+    import scipy.linalg as sla
+
+    x = np.frombuffer(nodes, dtype=float)
+    n_dof = (2 if kind == "beam" else 1) * len(x)
+    if kind == "beam":
+        basis = np.zeros((n_dof, 2))
+        basis[0::2, 0] = 1.0
+        basis[0::2, 1], basis[1::2, 1] = x - x[0], 1.0
+    else:
+        basis = np.ones((n_dof, 1))
+    fixed = basis[np.frombuffer(constrained, dtype=np.int64)]
+    null = sla.null_space(fixed) if fixed.size else np.eye(basis.shape[1])
+    for a in (basis, null):
+        a.flags.writeable = False
+    return basis, null
 
 
 @lru_cache(maxsize=256)

@@ -1211,6 +1211,14 @@ class FrameDiscretisation:
     def strain_energy(self, shapes, params=None) -> np.ndarray:
         return strain_energy(self.model, self.mesh, shapes)
 
+    def observation(self, measured) -> sp.csr_matrix:
+        """The sensors of ``measured`` read through the mesh
+        (:func:`gfe_opt.frame_data.observation`: a joint spring gives a member's end its own
+        rotation, so the matrix follows the effects)."""
+        from .frame_data import observation
+
+        return observation(self.model, self.mesh, measured.sensors)
+
     def rigid_body_count(self) -> int:
         """Rigid-body modes the supports and springs leave: the plane motions
         (u = a − θ y, v = b + θ x, every rotation θ) that vanish at the fixed DOFs and store

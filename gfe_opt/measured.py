@@ -648,12 +648,7 @@ def observation(disc, measured) -> sp.csr_matrix:
     """:func:`sensor_matrix` of a discretisation (its Timoshenko g, if any) and a test; a
     frame's sensors read through its mesh (:func:`gfe_opt.frame_data.observation`: a joint
     spring gives a member's end its own rotation, so the matrix follows the effects)."""
-    if disc.kind == "frame":
-        from .frame_data import observation as frame_observation
-
-        return frame_observation(disc.model, disc.mesh, measured.sensors)
-    return sensor_matrix(disc.nodes, disc.kind, measured.x, measured.dof, measured.source,
-                         shear_g=getattr(disc, "shear_g", None))
+    return disc.observation(measured)
 
 
 def sensor_matrix(nodes, kind: str, x, dof: str, source="measured",

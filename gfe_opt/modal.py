@@ -31,7 +31,6 @@ Results are deterministic (dense solvers; a fixed start vector for shift-invert)
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 import scipy.linalg as sla
@@ -352,50 +351,11 @@ def _reduced_element_stiffness(disc, U, params, L):
     return out + np.swapaxes(U, 1, 2) @ disc.extra_stiffness @ U
 
 
-def rigid_body_count(disc: Discretisation) -> int:
-    """How many rigid-body modes (ω = 0) the supports and springs leave: the motions
-    w = a + b x, θ = b (bar: u = a) that vanish at the constrained DOFs and store no strain
-    energy (a foundation or a spring to ground takes them away)."""
-    if disc.kind == "frame":
-        return disc.rigid_body_count()
-    basis, null = _rigid_motions(disc.kind, np.asarray(disc.nodes, float).tobytes(),
-                                 np.asarray(disc.constrained, dtype=np.int64).tobytes())
-    if null.shape[1] == 0:
-        return 0
-    motions = basis @ null
-    k = motions.shape[1]
-    # a rigid motion of the elements stores no strain energy (up to rounding): what the
-    # foundation and springs store decides; combinations count (a free beam on one spring
-    # still turns about it), so the k x k energy matrix by polarisation
-    pairs = np.stack([motions[:, i] + motions[:, j] for i in range(k) for j in range(k)], 1)
-    energy = disc.strain_energy(np.hstack([motions, pairs]))
-    single, both = energy[:k], energy[k:].reshape(k, k)
-    E = 0.5 * (both - single[:, None] - single[None, :])
-    u = motions[disc.element_dofs()]
-    Mr = np.einsum("eim,eij,ejn->mn", u, disc.mass, u)
-    lam = sla.eigh(0.5 * (E + E.T), Mr, eigvals_only=True)
-    return int(np.sum(lam <= 1e-9 * disc.eigenvalue_scale))
-
-
-@lru_cache(maxsize=256)
-def _rigid_motions(kind: str, nodes: bytes, constrained: bytes):
-    """The rigid motions w = a + b x, θ = b (bar: u = a) of a line's nodes (float64 bytes)
-    as columns of ``basis``, and ``null``, the combinations that vanish at the constrained
-    DOFs (int64 bytes); read-only, one pair for every discretisation of a mesh and its
-    supports (a fit builds hundreds)."""
-    x = np.frombuffer(nodes, dtype=float)
-    n_dof = (2 if kind == "beam" else 1) * len(x)
-    if kind == "beam":
-        basis = np.zeros((n_dof, 2))
-        basis[0::2, 0] = 1.0
-        basis[0::2, 1], basis[1::2, 1] = x - x[0], 1.0
-    else:
-        basis = np.ones((n_dof, 1))
-    fixed = basis[np.frombuffer(constrained, dtype=np.int64)]
-    null = sla.null_space(fixed) if fixed.size else np.eye(basis.shape[1])
-    for a in (basis, null):
-        a.flags.writeable = False
-    return basis, null
+def rigid_body_count(disc) -> int:
+    """How many rigid-body modes (ω = 0) the supports and springs leave
+    (:meth:`Discretisation.rigid_body_count`, a frame's
+    :meth:`~gfe_opt.frame.FrameDiscretisation.rigid_body_count`)."""
+    return disc.rigid_body_count()
 
 
 def model_modes(model: Model, n_modes: int) -> Modes:
