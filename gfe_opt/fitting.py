@@ -285,11 +285,9 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
 
 
 def _max_modes(model: Model, disc) -> int:
-    from .assembly import constrained_dofs
-
-    if model.kind == "frame":
-        return disc.free.size - 1
-    return model.n_dof - len(constrained_dofs(model)) - 1
+    """At most one fewer than the free DOFs (a support that gives frees its DOF: the
+    discretisation's, not the supports' count)."""
+    return disc.free.size - 1
 
 
 # -------------------------------------------------------------------------------------------
