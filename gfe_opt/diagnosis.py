@@ -750,11 +750,11 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     start = time.perf_counter()
     noise = noise_of(freq_noise, shape_noise)
     names = _candidates(model, candidates)
-    shape = structure(model)
-    measured, dropped, C = shape.prepared(measured)
+    layout = structure(model)
+    measured, dropped, C = layout.prepared(measured)
     baseline = misfit(model, measured, noise, C)
-    places = shape.failure_places(measured, noise)
-    hint = shape.hint(places)   # where the model fails, x / L
+    places = layout.failure_places(measured, noise)
+    hint = layout.hint(places)   # where the model fails, x / L
     reference = (fit_effects(model, measured, [], noise=noise, C=C)
                  if slots_for(model, []) and any(s.variables for s in slots_for(model, []))
                  else None)
@@ -942,7 +942,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     if realise and generic is not None:
         from .realisation import describe_profile, explain
 
-        nodal = shape.realise(generic)
+        nodal = layout.realise(generic)
         found = ranked[0] if ranked and ranked[0].significant else None
         if band is not None and found is not None:
             from .realisation import noisy_copies
@@ -1306,7 +1306,6 @@ def _generic_update(model, measured, noise):
 def _generic_only(model, measured, noise):
     """The paper's generic-element update of the measured data (None if it fails; a
     frame's member by member, :mod:`gfe_opt.frame_generic`)."""
-
     try:
         return structure(model).generic_update(measured, noise)
     except GENERIC_FAILURES:
@@ -1639,8 +1638,8 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     (their index in the model's effects, or a name the model holds once): a diagnosis's
     ``replace``."""
     noise = noise_of(freq_noise, shape_noise)
-    shape = structure(model)
-    measured, dropped, C = shape.prepared(measured, units=True)
+    layout = structure(model)
+    measured, dropped, C = layout.prepared(measured, units=True)
     before = misfit(model, measured, noise, C)
     taken = []
     if drop:
@@ -1652,7 +1651,7 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     for e in effects:
         effect_type(e.name).validate(model, dict(e.parameters), "--add", f"{e.name}:",
                                      partial=True)
-    shape.check_repeats([*model.effects, *effects], "--add")
+    layout.check_repeats([*model.effects, *effects], "--add")
     check_enough_modes(measured, [*model.effects, *effects])
     hint = None
     starts = []
@@ -1670,9 +1669,9 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
             starts.append(_profile_start(model, measured, e, noise))
             continue
         if hint is None:   # where the model fails (a frame's effects start everywhere)
-            hint = shape.start_hint(measured, noise)
+            hint = layout.start_hint(measured, noise)
         # along the structure, or along its member on a frame
-        along = shape.fraction(e.parameters.get("position"), e.parameters.get("member"))
+        along = layout.fraction(e.parameters.get("position"), e.parameters.get("member"))
         along = hint if along is None else along
         # fitted on top of the instances added before it: a second crack finds the second
         single = _fit_candidate(model, measured, e.name, noise, along, given=e.parameters,
@@ -1756,15 +1755,15 @@ def _profile_start(model, measured, effect, noise):
         return effect
     kind = effect_type(effect.name)
     member = effect.parameters.get("member")
-    shape = structure(model)
-    shape.check_member(effect)
-    band = shape.generic_band(measured, noise)
+    layout = structure(model)
+    layout.check_member(effect)
+    band = layout.generic_band(measured, noise)
     if "x" in effect.parameters:   # ratios from the generic update's reading, else 1
         x = effect.parameters["x"]
         start = kind.start_ratio(band, model, np.asarray(x)) or [1.0] * len(x)
         return Effect(effect.name, {**({} if member is None else {"member": member}),
                                     "x": list(x), "ratio": list(start)})
-    C = shape.sensor_matrix(measured)
+    C = layout.sensor_matrix(measured)
     ref = misfit(model, measured, noise, C)
     sel = _Selection(ref.chi2, 0, 1, measured.n_modes)
     chosen = _fallback(model, measured, noise, [effect.name], sel, band, None,

@@ -6,7 +6,7 @@ it asks :func:`structure` of its model, and the difference lives here:
 
 * **places**: along a line an effect's place is a position, fitted like any other
   variable; on a frame it is also a member or a joint, chosen from a list
-  (:attr:`Structure.discrete_places`): each member is a group of starts of its own, fitted
+  (:attr:`Line.discrete_places`): each member is a group of starts of its own, fitted
   as a job of its own, and the places that fit about as well are reported;
 * **sensors**: a line's sensors lie at positions x, read through one sensor matrix kept for
   the whole diagnosis; a frame's are read through its mesh, per model (a joint spring gives
@@ -15,7 +15,9 @@ it asks :func:`structure` of its model, and the difference lives here:
   chain of sensors on a frame;
 * **where the model fails**: x along the line; a sensor on a frame;
 * **spans** of a profile: the line; each member of a frame;
-* **the generic-element update**: of the line's elements; member by member on a frame.
+* **the generic-element update**: of the line's elements; member by member on a frame;
+* **a test's file**: a CSV's translations are a beam's w or a bar's u; a frame's own
+  formats name each sensor's place and direction.
 """
 
 from __future__ import annotations
@@ -25,6 +27,9 @@ import numpy as np
 from .errors import GfeSolverError
 
 __all__ = ["Frame", "Line", "structure"]
+
+#: the generic update's failures that leave a diagnosis without it (not an error)
+GENERIC_FAILURES = (GfeSolverError, ValueError, np.linalg.LinAlgError)
 
 
 def structure(model) -> Line | Frame:
@@ -238,6 +243,3 @@ def _discretise(model):
 
     return discretise(model)
 
-
-# the generic update's failures that leave the diagnosis without it (not an error)
-GENERIC_FAILURES = (GfeSolverError, ValueError, np.linalg.LinAlgError)
