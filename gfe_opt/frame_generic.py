@@ -33,6 +33,7 @@ from scipy.sparse.linalg import lsqr, splu
 
 from . import elements as el
 from .frame import (
+    FrameDiscretisation,
     FrameModel,
     _assemble,
     bending_stiffness,
@@ -60,9 +61,10 @@ class FrameGeneric:
     (``kind``, ``free``, ``n_dof``, ``n_elements``, ``stiffness_params``,
     :meth:`global_matrices`, :meth:`element_dofs`, :meth:`stiffness_elements`,
     :meth:`fixed_stiffness`, :meth:`element_strain_energy`, :meth:`with_stiffness`), and
-    ``model``/``mesh`` for the sensors' reading."""
+    :meth:`observation`, the sensors' reading through ``model`` and ``mesh``."""
 
     kind = "frame"
+    observation = FrameDiscretisation.observation
 
     def __init__(self, model: FrameModel):
         self.model = model
