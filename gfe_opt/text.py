@@ -143,8 +143,8 @@ def format_diagnosis(result, model) -> str:
         pair = result.together
         if pair is not None:
             held = len(model.effects)
-            lines.append("  together, fitted with each other (what update --add gives" +
-                         ("):" if model.kind == "frame" else "; the figures show these):"))
+            lines.append("  together, fitted with each other (what update --add gives; the "
+                         "figures show these):")
             lines += [f"    {e.name}: "
                       f"{effect_type(e.name).describe(e.parameters, s, pair.bound_of(i))}"
                       for i, (e, s) in enumerate(zip(pair.effects, pair.sigma)) if i >= held]
