@@ -153,8 +153,7 @@ def _solve(task: Task, model_path: Path, measured_path: Path, name: str) -> dict
     from .structure import structure
 
     model = load_model(model_path, frames=True)
-    # (a CSV's translations read as the model's: a bar's u; before, always a beam's w)
-    measured = structure(model).load_measured(measured_path)
+    measured = structure(model).load_measured(measured_path)   # a bar's CSV: u
     out = {"label": measured.label, "time": None if measured.time is None
            else str(measured.time)}
     if task.add:

@@ -1181,10 +1181,11 @@ def _fallback(model, measured, noise, names, sel, band, progress, members=None):
     a frame each member (or those of ``members``) is tried."""
     chosen = None
     # a beam's profile spans it; a frame's lies along one member (each member tried)
-    spans = structure(model).spans(members)
+    layout = structure(model)
+    spans = layout.spans(members)
     # m modes determine about 2m - 1 knots of a profile; on a frame a member's share of
     # them (the modes' curvature is spread over its members)
-    per_span = measured.n_modes / len(structure(model).spans())
+    per_span = measured.n_modes / len(layout.spans())
     for name in names:
         kind = effect_type(name)
         counts = [k for k in kind.knot_counts if k <= max(2, 2 * per_span - 1)]
@@ -1287,22 +1288,6 @@ def _pairs_with(model, measured, noise, best, fits, hint, explains, sel):
     return (_rank(explaining, sel)[0] if explaining else None), pairs
 
 
-def _generic_update(model, measured, noise):
-    """The paper's generic-element update (nodal k_i, ∂k_i/∂x) and its profile read against
-    its noise band (:func:`~gfe_opt.realisation.profile_band`)."""
-    from .assembly import discretise
-    from .realisation import profile_band
-    from .updating import update_generic
-
-    disc = discretise(model)
-    try:
-        result = update_generic(disc, measured, noise=max(noise.shape, 1e-3))
-    except GENERIC_FAILURES:
-        return None, None
-    band = profile_band(disc, measured, result, noise) if result.ok else None
-    return result, band
-
-
 def _generic_only(model, measured, noise):
     """The paper's generic-element update of the measured data (None if it fails; a
     frame's member by member, :mod:`gfe_opt.frame_generic`)."""
@@ -1320,8 +1305,8 @@ def _draw(model, data, noise):
 
 
 def _band(model, measured, noise, result, draws):
-    """(result, its profile band from the draws run beside it) as :func:`_generic_update`
-    gives them."""
+    """(result, its profile band from the draws run beside it), as
+    :meth:`~gfe_opt.structure.Line.generic_band` reads them."""
     from .realisation import profile_band
 
     if result is None:

@@ -181,7 +181,7 @@ def evaluate(model, measured, noise: Noise, C=None) -> Point | None:
 def model_modes(model, disc, measured) -> int:
     """How many model modes a residual pairs the measured ones with: four more than were
     measured, and the rigid-body ones."""
-    return min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(model, disc))
+    return min(measured.n_modes + 4 + rigid_body_count(disc), _max_modes(disc))
 
 
 def point_of(disc, K, M, modes, measured, noise: Noise, C=None) -> Point:
@@ -284,7 +284,7 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
     return J.reshape(-1, n)
 
 
-def _max_modes(model: Model, disc) -> int:
+def _max_modes(disc) -> int:
     """At most one fewer than the free DOFs (a support that gives frees its DOF: the
     discretisation's, not the supports' count)."""
     return disc.free.size - 1

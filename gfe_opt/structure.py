@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .assembly import discretise
 from .errors import GfeSolverError
 
 __all__ = ["Frame", "Line", "structure"]
@@ -64,7 +65,7 @@ class Line:
 
         model = self.model
         measured, dropped = on_model(measured, model)
-        check_model_size(_discretise(model), measured, model.source or model.name)
+        check_model_size(discretise(model), measured, model.source or model.name)
         if units:
             check_units(model, measured)
         return measured, dropped, self.sensor_matrix(measured)
@@ -107,20 +108,28 @@ class Line:
         """``(member, length)`` of each span a profile lies along: the line (member None)."""
         return [(None, self.model.length)]
 
-    def generic_update(self, measured, noise):
-        """The paper's generic-element update of the measured data (may raise)."""
+    def generic_update(self, measured, noise, disc=None):
+        """The paper's generic-element update of the measured data (may raise;
+        ``disc``: the model's discretisation, if built)."""
         from .updating import update_generic
 
-        return update_generic(_discretise(self.model), measured, noise=max(noise.shape, 1e-3))
+        disc = discretise(self.model) if disc is None else disc
+        return update_generic(disc, measured, noise=max(noise.shape, 1e-3))
 
     def generic_band(self, measured, noise):
-        """The generic update's stiffness profile read against its noise band (None on a
+        """The generic update's stiffness profile read against its noise band
+        (:func:`~gfe_opt.realisation.profile_band`; None where the update fails, and on a
         bar: its profile is EA's, which no start of a stiffness profile reads)."""
         if self.model.kind != "beam":
             return None
-        from .diagnosis import _generic_update
+        from .realisation import profile_band
 
-        return _generic_update(self.model, measured, noise)[1]
+        disc = discretise(self.model)
+        try:
+            result = self.generic_update(measured, noise, disc)
+        except GENERIC_FAILURES:
+            return None
+        return profile_band(disc, measured, result, noise) if result.ok else None
 
     def realise(self, generic) -> list | None:
         """The generic update read node by node in words (None on a bar)."""
@@ -128,7 +137,7 @@ class Line:
             return None
         from .realisation import realise
 
-        return realise(generic.discretisation, _discretise(self.model))
+        return realise(generic.discretisation, discretise(self.model))
 
     def check_repeats(self, effects, where: str) -> None:
         """At most one instance of a global effect."""
@@ -168,7 +177,7 @@ class Frame(Line):
         from .correlation import check_model_size
 
         model = self.model
-        check_model_size(_discretise(model), measured, model.source or model.name)
+        check_model_size(discretise(model), measured, model.source or model.name)
         return measured, [], None
 
     def sensor_matrix(self, measured):
@@ -216,7 +225,7 @@ class Frame(Line):
             return None
         from .realisation import realise_members
 
-        return realise_members(generic.discretisation, _discretise(self.model))
+        return realise_members(generic.discretisation, discretise(self.model))
 
     def check_repeats(self, effects, where: str) -> None:
         """One joint spring a member end, one axial load a member."""
@@ -236,10 +245,4 @@ class Frame(Line):
         if effect.parameters.get("member") is None:
             raise GfeInputError("--add", effect.name, f"a {effect.name} on a frame needs its "
                                 f"member: --add {effect.name}:member=ID")
-
-
-def _discretise(model):
-    from .assembly import discretise
-
-    return discretise(model)
 

@@ -161,16 +161,24 @@ def run_case(case) -> dict:
     return row
 
 
-def perturbed(case, eps: float):
-    """``case`` with its measured frequencies and shape values each multiplied by
-    1 + ``eps`` × a normal draw (seeded by the case's name: the same draws every run): at
-    ``eps`` 1e-9 the data are the same to every digit a test reports, and a decision that
+def perturbation(name: str, eps: float):
+    """A function multiplying each array it is given (None passes) by 1 + ``eps`` × a normal
+    draw, seeded by a case's ``name`` (the same draws every run; the frame campaign's too):
+    at ``eps`` 1e-9 the data are the same to every digit a test reports, and a decision that
     changes hinged on rounding."""
-    rng = np.random.default_rng(list(case.name.encode()))
+    rng = np.random.default_rng(list(name.encode()))
 
     def scaled(a):
         return None if a is None else a * (1 + eps * rng.standard_normal(a.shape))
-    return replace(case, frequencies=scaled(case.frequencies), shapes=scaled(case.shapes))
+    return scaled
+
+
+def perturbed(case, eps: float):
+    """``case`` with its measured frequencies, then its shape values, perturbed
+    (:func:`perturbation`)."""
+    scaled = perturbation(case.name, eps)
+    frequencies = scaled(case.frequencies)
+    return replace(case, frequencies=frequencies, shapes=scaled(case.shapes))
 
 
 def follow(model, measured, noise, result, row):

@@ -376,15 +376,12 @@ def _size(model, effect: Effect):
 
 
 def perturbed(case: dict, eps: float) -> dict:
-    """``case`` with its measured frequencies and shape values each multiplied by
-    1 + ``eps`` × a normal draw (seeded by the case's name; ``bench_diagnosis.perturbed``)."""
+    """``case`` with its measured frequencies, then its shape values, perturbed
+    (``bench_diagnosis.perturbation``)."""
     m = case["measured"]
-    rng = np.random.default_rng(list(case["name"].encode()))
-
-    def scaled(a):
-        return None if a is None else a * (1 + eps * rng.standard_normal(a.shape))
-    return {**case, "measured": replace(m, frequencies_hz=scaled(m.frequencies_hz),
-                                        shapes=scaled(m.shapes))}
+    scaled = bench_diagnosis.perturbation(case["name"], eps)
+    frequencies = scaled(m.frequencies_hz)
+    return {**case, "measured": replace(m, frequencies_hz=frequencies, shapes=scaled(m.shapes))}
 
 
 def run_case(case: dict) -> dict:
