@@ -46,6 +46,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.linalg import block_diag
 from scipy.special import chdtri
 
@@ -217,14 +218,17 @@ def point_of(disc, K, M, modes, measured, noise: Noise, C=None) -> Point:
 
 
 def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upper,
-                   step: float = 1e-5) -> np.ndarray:
+                   step: float = 1e-5, columns=None) -> np.ndarray:
     """The Jacobian of the residual at ``point`` (the evaluation at z) with respect to z,
     the pairing held: eigenvalue and eigenvector derivatives
     (:func:`~gfe_opt.sensitivity.eigen_derivatives`) with ∂K, ∂M (and, for a shear beam,
     the observation's ∂C) from second-order differences of the *matrices* of
     ``model_at(z)`` (central; at a bound one-sided three-point, stepping inwards), no
     modal solve besides the one of ``point``.  Raises ``ValueError`` where the modes have no
-    derivative (a repeated or zero eigenvalue among the paired ones)."""
+    derivative (a repeated or zero eigenvalue among the paired ones).  ``columns``: only
+    those columns are wanted (the others come out zero): the matrices of the other
+    variables are not built, and the eigen-derivatives still solve for every column (zero
+    ones there), so each wanted column is the full Jacobian's to the last bit."""
     from .sensitivity import eigen_derivatives
 
     n = z.size
@@ -236,7 +240,14 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
         return K, M, (observation(disc, measured) if shear else None)
 
     dK, dM, dC = [], [], []
+    wanted = range(n) if columns is None else set(int(k) for k in columns)
     for k in range(n):
+        if k not in wanted:
+            zero = sp.csr_matrix(point.K.shape)
+            dK.append(zero)
+            dM.append(zero)
+            dC.append(sp.csr_matrix(point.C.shape) if shear else None)
+            continue
         h = step * max(1.0, abs(z[k]))
         up, down = z.copy(), z.copy()
         if z[k] + h <= upper[k] and z[k] - h >= lower[k]:
@@ -505,12 +516,13 @@ class Objective:
         point = self.point(z)
         return np.full(self.measured.n_values, FAILED_RESIDUAL) if point is None else point.r
 
-    def _analytic(self, z, r, lower, upper) -> np.ndarray:
+    def _analytic(self, z, r, lower, upper, columns=None) -> np.ndarray:
         point = self.point(z)
         if point is not None:
             try:
                 return point_jacobian(point, np.asarray(z, dtype=float), self.model_at,
-                                      self.measured, self.noise, lower, upper)
+                                      self.measured, self.noise, lower, upper,
+                                      columns=columns)
             except _TRIAL_ERRORS:
                 pass
         self.fallbacks += 1
@@ -773,7 +785,7 @@ def _profile_starts(residual, chi2, z0, grids, slots, lower, upper, nulls=None) 
         r = residual(z)
         for _ in range(PROFILE_STEPS):
             if getattr(residual, "jacobian", None) is not None:
-                J = residual.jacobian(z, r, lower, upper)[:, inner]
+                J = residual.jacobian(z, r, lower, upper, columns=inner)[:, inner]
             else:
                 J = np.empty((r.size, inner.size))
                 for k in inner:
