@@ -274,7 +274,8 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
     phi = point.modes.shapes[:, cols]
     dlam, dphi = eigen_derivatives(point.K, point.M, point.disc.free, lam, phi, dK, dM,
                                    all_lam=lam_all,
-                                   dense=getattr(point.disc, "dense_derivatives", None))
+                                   dense=getattr(point.disc, "dense_derivatives", None),
+                                   shapes=not measured.frequency_only)
     f_model = point.modes.frequencies_hz[cols]
     dfreq = dlam / (2 * lam[:, None]) * (f_model / measured.frequencies_hz[rows])[:, None] \
         / noise.freq

@@ -42,14 +42,17 @@ class RepeatedEigenvalue(ValueError):
     """A mode's eigenvalue is (numerically) repeated: its shape is not differentiable."""
 
 
-def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None):
+def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None,
+                      shapes: bool = True):
     """Derivatives of the eigenpairs (λ_j, φ_j) (columns of ``phi``, all DOFs, zero at the
     constrained ones, mass-normalised) with respect to p parameters.
 
     ``dK``, ``dM``: lists of p sparse (or dense) matrices over all DOFs; ``free``: the free
     DOFs; ``all_lam``: every computed eigenvalue (to refuse repeated ones).  Returns
     ``(dlam, dphi)`` of shapes (m, p) and (n_dof, m, p).  ``dense``: LAPACK on the
-    bordered system or Nelson's sparse form (None: dense up to :data:`DENSE_DOFS`)."""
+    bordered system or Nelson's sparse form (None: dense up to :data:`DENSE_DOFS`).
+    Without ``shapes`` (frequencies alone are fitted) ``dphi`` stays zero: no system is
+    solved, and ``dlam`` is the same to the last bit."""
     free = np.asarray(free, dtype=int)
     dense = free.size <= DENSE_DOFS if dense is None else dense
     K, M = _as(K, dense), _as(M, dense)
@@ -78,9 +81,9 @@ def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None):
         dMf = [_FreeRows(sp.csr_matrix(d), free) for d in dM]
     kd = np.abs(Kf.diagonal())
     d = 1.0 / np.sqrt(np.where(kd > 0, kd, 1.0))
-    if dense:
+    if dense and shapes:
         Ks, Ms = Kf * np.outer(d, d), Mf * np.outer(d, d)
-    else:
+    elif shapes:
         D = sp.diags(d)
         pencil = _Pencil((D @ Kf @ D).tocsc(), (D @ Mf @ D).tocsc())
     for j in range(m):
@@ -95,6 +98,8 @@ def eigen_derivatives(K, M, free, lam, phi, dK, dM, all_lam=None, dense=None):
         Mxk = [dMf[k] @ xk for k in range(p)]
         g = np.column_stack([dKf[k] @ xk - lam[j] * Mxk[k] for k in range(p)])
         dlam[j] = x @ g
+        if not shapes:
+            continue
         half = np.array([-0.5 * float(x @ Mxk[k]) for k in range(p)])
         rhs_top = -g + np.outer(Mx, dlam[j])
         border = d * Mx
