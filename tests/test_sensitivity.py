@@ -107,6 +107,31 @@ def test_analytic_jacobian_matches_central_differences(kind, name, frequency_onl
     assert np.max(error) < 1e-6, (name, error)
 
 
+@pytest.mark.parametrize("frequency_only", [False, True], ids=["shapes", "frequencies"])
+def test_a_jacobians_chosen_columns_are_the_full_ones_to_the_last_bit(frequency_only):
+    """Profile starts ask for the inner effects' columns only (the others' matrices are not
+    built) and a frequency-only fit for no eigenvector systems: each column must still be
+    the full Jacobian's bit for bit, or the fits would start elsewhere than before."""
+    model = make_model(supports={"left": "clamped", "right": "pinned"}, elements=24)
+    x = np.linspace(0.013, model.length - 0.011, 17)
+    measured = _measured(model, 4, x, frequency_only)
+    pairs = [("material", "crack"), ("support_spring", "section_loss"),
+             ("point_mass", "point_spring")]
+    for first, second in pairs:
+        problem = fit_problem(model, measured, [_instance(model, first),
+                                                _instance(model, second)], noise=NOISE)
+        lower, upper = problem.lower, problem.upper
+        z = lower + 0.4 * (upper - lower)
+        r = problem.residual(z)
+        full = problem.residual.jacobian(z, r, lower, upper)
+        assert problem.residual.fallbacks == 0
+        inner = np.arange(len(problem.slots[0].variables))
+        part = problem.residual.jacobian(z, r, lower, upper, columns=inner)
+        assert np.array_equal(part[:, inner], full[:, inner]), (first, second)
+        assert not np.any(part[:, inner.size:]), "the columns not asked for are not built"
+        assert np.any(full[:, inner.size:]), "the full Jacobian has them"
+
+
 def test_eigen_derivatives_of_a_two_dof_system_match_the_closed_form():
     """K = [[2k, -k], [-k, k]], M = I: λ = k (3 ∓ √5)/2; d/dk at fixed M is λ/k, shapes
     do not change (they do not depend on k)."""
@@ -155,6 +180,14 @@ def test_dense_and_sparse_solves_agree(monkeypatch):
                                phi[:, :4], dK, dM, all_lam=lam)
     for a, b in zip(dense, sparse):
         assert np.allclose(a, b, rtol=0, atol=1e-12 * np.max(np.abs(a)))
+    # without the shapes (frequencies alone): no system is solved, the same λ' to the bit
+    for dense in (True, False):
+        both = eigen_derivatives(K, M, np.arange(n), lam[:4], phi[:, :4], dK, dM,
+                                 all_lam=lam, dense=dense)
+        alone = eigen_derivatives(K, M, np.arange(n), lam[:4], phi[:, :4], dK, dM,
+                                  all_lam=lam, dense=dense, shapes=False)
+        assert np.array_equal(alone[0], both[0]) and not np.any(alone[1])
+        assert np.any(both[1])
 
 
 def test_nelsons_shifted_pencil_is_sparse_arithmetic_and_slicing_bit_for_bit():
