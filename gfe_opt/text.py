@@ -172,7 +172,7 @@ def format_diagnosis(result, model) -> str:
         where = ("where the model fails: " + ", ".join(_place(x) for x, _ in
                                                        result.localisation)
                  if result.localisation else "where it fails is unknown without mode shapes")
-        lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 fits to the noise); {where}")
+        lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 is at the noise); {where}")
     words = list(result.realisation)
     if words and words[0].startswith("the generic-element update"):
         lines += words[:1] + [f"  {w}" for w in words[1:]]
