@@ -79,6 +79,16 @@ class ModeCounts:
     def omega(self) -> np.ndarray:
         return 2.0 * np.pi * self.frequencies_hz
 
+    def without_shapes_note(self) -> str | None:
+        """Why the shapes are not used, or None (a beam's test or a frame's)."""
+        if not self.frequency_only:
+            return None
+        what = ("no mode shapes" if self.n_sensors == 0 else
+                f"shapes at {self.n_sensors} sensor{'s' if self.n_sensors > 1 else ''} "
+                "cannot tell modes apart")
+        return (f"{what}: modes paired by frequency (nearest, one to one) and only "
+                "frequencies compared; MAC and where the model fails are unavailable")
+
 
 @dataclass(frozen=True)
 class MeasuredModes(ModeCounts):
@@ -101,15 +111,6 @@ class MeasuredModes(ModeCounts):
     def n_sensors(self) -> int:
         return len(self.x)
 
-    def without_shapes_note(self) -> str | None:
-        """Why the shapes are not used, or None."""
-        if not self.frequency_only:
-            return None
-        what = ("no mode shapes" if self.n_sensors == 0 else
-                f"shapes at {self.n_sensors} sensor{'s' if self.n_sensors > 1 else ''} "
-                "cannot tell modes apart")
-        return (f"{what}: modes paired by frequency (nearest, one to one) and only "
-                "frequencies compared; MAC and where the model fails are unavailable")
 
 
 

@@ -799,6 +799,28 @@ def test_cli_compare_on_a_frame(tmp_path):
     assert len(bad.stderr.strip().splitlines()) == 1
 
 
+def test_diagnose_reads_a_frames_test_of_frequencies_alone(tmp_path):
+    """A frame's test without sensors (the contract's frequency-only file) is diagnosed and
+    says why its shapes are not used; it ended in an internal error (the frame's test had
+    no ``without_shapes_note``) after every fit had run.  The shipped semi-rigid portal's
+    frequencies, read with the material alone: E falls (its joints give)."""
+    data = json.loads(problem_file("portal-frame-semirigid.json").read_text())
+    path = tmp_path / "portal-frequencies.json"
+    path.write_text(json.dumps({"modes": [{"frequency": m["frequency"]}
+                                          for m in data["modes"]]}))
+    frame = str(problem_file("portal-frame.toml"))
+    run = subprocess.run([sys.executable, "-m", "gfe_opt", "diagnose", frame, str(path),
+                          "--candidates", "material", "--json"], capture_output=True,
+                         text=True)
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout)
+    assert any(n.startswith("no mode shapes: modes paired by frequency") for n in out["notes"])
+    model = portal_frame()
+    found = out["effects"][0]
+    assert found["effect"] == "material"
+    assert found["parameters"]["E"] < model.members[0].E
+
+
 def test_the_shipped_semirigid_portal_test_is_the_exact_solution_it_says():
     """Regenerated on this machine's arithmetic: the exact roots and null vectors agree to
     far below the noise the file carries (5e-4, 3e-3); another BLAS kernel moves the roots
