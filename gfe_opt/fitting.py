@@ -241,12 +241,13 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
 
     dK, dM, dC = [], [], []
     wanted = range(n) if columns is None else set(int(k) for k in columns)
+    zero = sp.csr_matrix(point.K.shape)
+    zero_c = sp.csr_matrix(point.C.shape) if shear else None
     for k in range(n):
         if k not in wanted:
-            zero = sp.csr_matrix(point.K.shape)
             dK.append(zero)
             dM.append(zero)
-            dC.append(sp.csr_matrix(point.C.shape) if shear else None)
+            dC.append(zero_c)
             continue
         h = step * max(1.0, abs(z[k]))
         up, down = z.copy(), z.copy()
