@@ -298,6 +298,9 @@ class Diagnosis:
                 "together": None if self.together is None else {
                     "effects": [self.together.effect_json(i)
                                 for i in range(len(self.together.effects))],
+                    "traded": list(self.together.traded),
+                    "told": jsonable(self.together.told[self.together.added])
+                    if self.together.added is not None and self.together.told else {},
                     **self.together.misfit.summary()},
                 "remaining": None if self.remaining is None else jsonable(self.remaining),
                 "offered": list(self.offered),
@@ -876,7 +879,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                              f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}; frequency error "
                              f"{pair.misfit.freq_error_rms_pct:.3g} %): add them together")
                 suggested, together = [first.name, pair.name], pair
-                notes += equivalent_notes(pair, measured)
+                notes += equivalent_notes(pair, measured) + _traded_notes(pair)
                 if profile is not None:
                     notes += _close_profile(profile, pair, sel)
                     profile.significant = False  # named effects win where they explain
@@ -897,7 +900,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                              f"free {profile.name} (χ²/n "
                              f"{tied.misfit.chi2_per_residual:.3g} against "
                              f"{profile.misfit.chi2_per_residual:.3g}): add them together")
-                notes += equivalent_notes(tied, measured)
+                notes += equivalent_notes(tied, measured) + _traded_notes(tied)
                 profile.significant = False
             elif profile is not None and profile.significant and sel.better(profile, best) \
                     and not rivalled:
@@ -1682,10 +1685,20 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
                                 *([traded_note(fit)] if fit.traded else [])])
 
 
+def _traded_notes(fit) -> list[str]:
+    """:func:`traded_note` of a fit whose parameters trade as told, else nothing."""
+    return [traded_note(fit)] if fit.traded else []
+
+
 def traded_note(fit) -> str:
     """What a fit whose parameters trade as its effect allows (:attr:`Fit.traded`) tells:
     the combinations the data fix, with their σ (:attr:`Fit.told`, the JSON's ``told``)."""
     told = fit.told[fit.added] if fit.added is not None and fit.told else {}
+    if told and all(key.endswith(" sum") for key in told):
+        # two instances' sizes trading (:func:`~gfe_opt.fitting._uncertainty`'s told sums)
+        return "; ".join(f"the data fix {t['label']}, {t['value']:.4g} ± {t['sigma']:.2g} "
+                         f"{t['unit']}, not how it splits between them"
+                         for t in told.values()) + " (each ± above is taken along that trade)"
     said = "; ".join(f"{t['label']} = {t['value']:.3g} ± {t['sigma']:.2g} {t['unit']}"
                      for t in told.values())
     return (f"{fit.name}: " + "; ".join(fit.traded) + ": the data fix their combination ("

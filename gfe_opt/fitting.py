@@ -1081,11 +1081,13 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
         sd_z = sd
     names, unidentified = [], []
     wide = {}   # variable -> (slot, key, its σ above its value)
+    sizes = {}  # variable -> (its physical value, d value / d variable)
     i = 0
     for j, slot in enumerate(slots):
         for v in slot.variables:
             phys = v.physical(base, z[i])
             derivative = phys * np.log(10.0) if v.log else v.scale(base)
+            sizes[i] = (phys, derivative)
             value = abs(derivative) * sd_z[i]
             if v.index is None:
                 out[j][v.key] = float(value)
@@ -1138,12 +1140,42 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
         in_trade.update((owner[a], k) for k in keys)
         return True
 
+    shared = {}   # slot -> {key: told entry} of the sums two instances' trades leave told
+
+    def summed(a, b) -> bool:
+        """On a frame, the same size of two instances of one kind (two joints' springs)
+        trading: the data fix their sum, not how it splits between them (frequencies alone
+        on a symmetric portal, whose two beam ends move every frequency alike to first
+        order).  Told, with the sum's σ, when that σ does not exceed the sum (as any size's
+        must not); beams keep the stricter rule their campaign judged."""
+        if T is not None or base.kind != "frame" or owner[a] == owner[b] or held[a] \
+                or held[b]:
+            return False
+        ea, eb = slots[owner[a]].effect, slots[owner[b]].effect
+        key = names[a].split(".", 1)[1]
+        if ea.name != eb.name or key != names[b].split(".", 1)[1] \
+                or ea.parameter(key).rule != "positive":
+            return False
+        g = np.zeros(m)
+        g[a], g[b] = sizes[a][1], sizes[b][1]
+        total = sizes[a][0] + sizes[b][0]
+        sigma = float(np.sqrt(max(float(g @ np.where(np.isfinite(cov), cov, 0.0) @ g), 0.0)))
+        if not np.all(np.isfinite(cov[np.ix_([a, b], [a, b])])) or not sigma <= abs(total):
+            return False
+        parameter = ea.parameter(key)
+        entry = {"label": f"the sum of the two {ea.name}s' {key}",
+                 "unit": parameter.unit, "value": float(total), "sigma": sigma}
+        for k in (owner[a], owner[b]):
+            shared.setdefault(k, {})[f"{key} sum"] = entry
+        in_trade.update(((owner[a], key), (owner[b], key)))
+        return True
+
     traded = []
     for a in range(m):
         for b in range(a + 1, m):
             if (a in added or b in added) and np.isfinite(corr[a, b]) \
                     and abs(corr[a, b]) > IDENTIFIABLE_CORRELATION and trades(a, b):
-                (traded if told(a, b) else unidentified).append(
+                (traded if told(a, b) or summed(a, b) else unidentified).append(
                     f"{names[a]} and {names[b]} trade against each other (correlation "
                     f"{corr[a, b]:+.3f})")
     # a σ above its value that a told trade explains is that trade's (a short zone's
@@ -1151,7 +1183,10 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     for j, key, sentence in wide.values():
         (traded if (j, key) in in_trade else unidentified).append(sentence)
     finite = np.where(np.isfinite(cov), cov, 0.0) if T is None else cov_z
-    return out, unidentified, traded, _told(slots, base, z, finite, held)
+    told_values = _told(slots, base, z, finite, held)
+    for k, entries in shared.items():
+        told_values[k].update(entries)
+    return out, unidentified, traded, told_values
 
 
 def _told(slots, base, z, cov_z, held) -> list[dict]:
