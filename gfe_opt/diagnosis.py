@@ -1422,8 +1422,63 @@ def _undetermined(fit, model) -> list:
     for effects in fit.equivalent:
         if symmetric and _mirrored(fit.effects, effects, model.length):
             continue
+        if model.kind == "frame" and _swapped(fit.effects, effects, model):
+            continue
         out.append(effects)
     return out
+
+
+def _swapped(effects, others, model) -> bool:
+    """On a frame, two effect lists with the same instances at the same places whose sizes
+    are assigned the other way round (two joint springs of a symmetric portal from
+    frequencies alone: 980 N m/rad at B and 5040 at C, or 5040 at B and 980 at C): the
+    data tell both sizes and both places, not which is which; the finding stands, the
+    other assignment said beside it (:func:`equivalent_notes`).  Places agree in their
+    names (node, member) and positions within 2 % of their member's length; sizes within
+    5 %.  Beams keep the stricter rule their campaign judged."""
+    if len(effects) != len(others) or len(effects) < 2:
+        return False
+
+    def place(e):
+        names = tuple(sorted((k, v) for k, v in e.parameters.items() if isinstance(v, str)))
+        return e.name, names
+
+    def sizes(e):
+        return {k: v for k, v in e.parameters.items()
+                if isinstance(v, (int, float)) and k != "position"}
+
+    def near(a, b, scale):
+        return abs(a - b) <= scale
+
+    def same_place(a, b):
+        if place(a) != place(b):
+            return False
+        pa, pb = a.parameters.get("position"), b.parameters.get("position")
+        if pa is None or pb is None:
+            return pa is None and pb is None
+        member = a.parameters.get("member")
+        length = (model.member_length(model.member(member)) if member is not None
+                  else model.length)
+        return near(pa, pb, 0.02 * length)
+
+    def same_size(a, b):
+        sa, sb = sizes(a), sizes(b)
+        return sa.keys() == sb.keys() and all(
+            near(sa[k], sb[k], 0.05 * max(abs(sa[k]), abs(sb[k]), 1e-300)) for k in sa)
+
+    if not all(any(same_place(a, b) for b in others) for a in effects):
+        return False          # not the same places
+    if all(same_size(a, b) for a, b in zip(effects, others)
+           if same_place(a, b)) and all(same_place(a, b) for a, b in zip(effects, others)):
+        return False          # the same fit, not a swap
+    # the sizes as a whole are the same, each at another of the places
+    remaining = list(others)
+    for a in effects:
+        match = next((b for b in remaining if b.name == a.name and same_size(a, b)), None)
+        if match is None:
+            return False
+        remaining.remove(match)
+    return True
 
 
 def _mirrored(effects, others, length) -> bool:
