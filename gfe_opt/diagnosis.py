@@ -702,13 +702,15 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
         kind = effect_type(f.name)
         f.gain = sel.reference_chi2 - f.misfit.chi2
         f.size_sigmas = kind.size_in_sigmas(base, f.parameters, f.uncertainty)
-        if any(kind.parameter(k).null is not None for k in f.bound) or kind.told_trades(base):
+        if any(kind.parameter(k).null is not None for k in f.bound) or kind.told_trades(base) \
+                or f.traded:
             # a parameter on a bound of its range has no σ to measure a distance with, nor
             # an effect whose parameters trade as it allows (a zone on a frame: "no effect"
             # is a whole line, ratio 1 at any length or length 0 at any ratio, and each σ
             # spans the trade: a 2 cm zone fitting 30 times the floor better was 2.99 σ
             # from nothing): the distance from "no effect" is the likelihood ratio's,
-            # √(gain / floor) (what |value − null|/σ is for a linear model)
+            # √(gain / floor) (what |value − null|/σ is for a linear model); so is one whose
+            # size trades with another instance's (on a frame, told: :attr:`Fit.traded`)
             f.size_sigmas = float(np.sqrt(max(f.gain, 0.0) / sel.floor))
         f.threshold = sel.threshold(f)
         # what it explains alone exceeds its threshold, whatever its size's σ (one loose
@@ -1234,7 +1236,7 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
         # leads a pair too, after it (two loose joints of a portal read as E 25-33 % low,
         # which no second effect completes, where the two joints explain the data; one
         # joint alone stands for both and is barely determined)
-        firsts += [f for f in _rank([f for f in fits if f.gains_enough
+        firsts += [f for f in _rank([f for f in fits if _may_lead(f, model)
                                      and not any(f is g for g in firsts)], sel)
                    if not getattr(effect_type(f.name), "fallback", False)]
     tried = []
@@ -1249,6 +1251,19 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
                 first.significant = first.leads_pair = True
             return first, second, tried
     return best, None, tried
+
+
+def _may_lead(fit, model) -> bool:
+    """A fit that may lead a pair when a uniform change fits best alone: it explains more
+    than its threshold alone (:attr:`Fit.gains_enough`).  On a frame, whether the data
+    determine it alone does not matter either, since the pair is judged itself: one base
+    spring of a symmetric portal standing for two (from frequencies alone, a near hinge
+    with σ above its value) leads the pair that explains, its sum told.  Beams keep the
+    stricter rule their campaign judged."""
+    if fit.gains_enough:
+        return True
+    return (model.kind == "frame" and fit.success and not fit.failed
+            and fit.gain > fit.threshold)
 
 
 def _simplest_first(model, measured, noise, hint, explains, sel, first, pair, others, tried):

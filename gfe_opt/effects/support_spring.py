@@ -24,6 +24,11 @@ class SupportSpring(EffectType):
     )
     frame_parameters = (Parameter("node", "", "choice", "the supported node (a frame)"),)
 
+    def is_local(self, model) -> bool:
+        """One at a beam's end (``side`` "both" for the two); on a frame one a supported
+        node, any number of nodes (two bases that give are two instances)."""
+        return model.kind == "frame"
+
     def check(self, model, params, where, prefix):
         side = params.get("side")
         if side is None:

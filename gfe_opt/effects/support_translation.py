@@ -40,6 +40,11 @@ class SupportTranslation(EffectType):
                         Parameter("direction", "", "choice", "x or y (a frame)",
                                   choices=("x", "y")))
 
+    def is_local(self, model) -> bool:
+        """One at a beam's end (``side`` "both" for the two); on a frame one a supported
+        node, any number of nodes (two bases that give are two instances)."""
+        return model.kind == "frame"
+
     def check(self, model, params, where, prefix):
         for side in effect_sides(params):
             end = ("left", "right").index(side)
