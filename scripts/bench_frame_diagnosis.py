@@ -384,6 +384,13 @@ def perturbed(case: dict, eps: float) -> dict:
     return {**case, "measured": replace(m, frequencies_hz=frequencies, shapes=scaled(m.shapes))}
 
 
+def frequencies_only(case: dict) -> dict:
+    """``case`` with its test's shapes taken out (its frequencies, as measured with their
+    noise, alone: a frame test of frequencies only)."""
+    m = case["measured"]
+    return {**case, "measured": replace(m, sensors=[], shapes=None)}
+
+
 def run_case(case: dict) -> dict:
     model, measured, noise = case["model"], case["measured"], case["noise"]
     said = []
@@ -473,6 +480,9 @@ def main(argv=None) -> int:
                     help="multiply every measured frequency and shape value by 1 + EPS times "
                     "a normal draw (seeded by the case), e.g. 1e-9: which decisions hinge on "
                     "rounding, on one machine")
+    ap.add_argument("--frequencies-only", action="store_true",
+                    help="diagnose each case's frequencies alone (its shapes taken out): "
+                    "what a test without sensors tells")
     args = ap.parse_args(argv)
     diagnosis.SERIAL_FITS = True    # one core per campaign: run seeds side by side
     rows = []
@@ -487,6 +497,8 @@ def main(argv=None) -> int:
         case = make_case(seed, group)
         if args.perturb:
             case = perturbed(case, args.perturb)
+        if args.frequencies_only:
+            case = frequencies_only(case)
         try:
             row = run_case(case)
         except Exception as exc:     # scored as wrong, the campaign goes on
@@ -498,7 +510,8 @@ def main(argv=None) -> int:
         print(f"[{n}/{len(seeds)}] {row['name']}: {' -> '.join(row.get('verdicts', []))} "
               f"added {row.get('added')} {'OK' if row['verdict_right'] else 'WRONG'} "
               f"({row['seconds']:.1f} s)", file=sys.stderr, flush=True)
-    doc = {"seed": args.seed, "cases": rows, "scorecard": scorecard(rows)}
+    doc = {"seed": args.seed, "frequencies_only": args.frequencies_only, "cases": rows,
+           "scorecard": scorecard(rows)}
     text = json.dumps(doc, indent=1, default=float)
     if args.json:
         Path(args.json).write_text(text + "\n")
