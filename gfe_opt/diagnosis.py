@@ -1353,7 +1353,9 @@ def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[st
     notes = []
     if alike:
         what = "the frequencies" if measured.frequency_only else "the data"
-        notes.append(f"{what} cannot tell {best.name} from " + ", ".join(
+        # with a pair suggested, the comparison is of the effects alone, not of the pair
+        alone = "alone, " if together is not None else ""
+        notes.append(f"{alone}{what} cannot tell {best.name} from " + ", ".join(
             f"{f.name} (χ²/n {f.misfit.chi2_per_residual:.3g} against "
             f"{best.misfit.chi2_per_residual:.3g})" for f in alike)
             + (": measure mode shapes to decide" if measured.frequency_only else ""))
