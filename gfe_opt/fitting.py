@@ -945,7 +945,12 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
         lowest_eig = float(np.linalg.eigvalsh(H)[0])
         decrement = float(ur @ ur)
         if lowest_eig > 0:
-            decrement = max(decrement, float(gk @ np.linalg.solve(H, gk)))
+            try:
+                decrement = max(decrement, float(gk @ np.linalg.solve(H, gk)))
+            except np.linalg.LinAlgError:
+                # positive to eigvalsh, singular to the LU (a frame's zone from frequencies
+                # alone, the campaign's zone-3307): the Gauss-Newton decrement stands
+                pass
         if decrement < FINISH_DECREMENT * floor:
             return z, value, decrement / floor
         shift = max(0.0, -lowest_eig) + 1e-12 * sv[0] ** 2   # H + shift: positive definite
@@ -1115,7 +1120,10 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
         w, V = np.linalg.eigh(sub)
         if not np.all(np.isfinite(cov[:, [a, b]])) or w[-1] <= 0.0:
             return True
-        d = cov[:, [a, b]] @ np.linalg.solve(sub, V[:, -1] * np.sqrt(w[-1]))
+        try:
+            d = cov[:, [a, b]] @ np.linalg.solve(sub, V[:, -1] * np.sqrt(w[-1]))
+        except np.linalg.LinAlgError:   # a block singular to rounding: its eigenvector
+            d = cov[:, [a, b]] @ (V[:, -1] / np.sqrt(w[-1]))
         chi0, rises = float(r0 @ r0), []
         for sign in (1.0, -1.0):
             step = sign * TRADE_STEP_SIGMAS * (d if T is None else T @ d)
