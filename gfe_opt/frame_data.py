@@ -581,6 +581,40 @@ def effect_place(model: FrameModel, effect) -> str:
     return str(p.get("member", "the frame"))
 
 
+def mirror_members(model: FrameModel) -> dict | None:
+    """{member id: (its image's id, whether the image runs the other way)} when the frame
+    (nodes, supports, members' sections, materials and meshes; its effects not looked at)
+    is its own mirror image about the vertical line through the middle of its nodes'
+    x-range, else None.  A portal's beam is its own image, run the other way; its columns
+    are each other's.  Nodes match within 10⁻⁶ of the frame's size."""
+    xs = [x for x, _ in model.nodes.values()]
+    ys = [y for _, y in model.nodes.values()]
+    middle = 0.5 * (min(xs) + max(xs))
+    tol = 1e-6 * max(max(xs) - min(xs), max(ys) - min(ys), 1e-300)
+    image = {}
+    for node, (x, y) in model.nodes.items():
+        match = [n for n, (u, v) in model.nodes.items()
+                 if abs(u - (2 * middle - x)) <= tol and abs(v - y) <= tol]
+        if len(match) != 1:
+            return None
+        image[node] = match[0]
+    supports = dict(model.supports)
+    if any(supports.get(image[n]) != t for n, t in supports.items()):
+        return None
+    ends = {(m.start, m.end): m for m in model.members}
+    out = {}
+    for m in model.members:
+        forward = ends.get((image[m.start], image[m.end]))
+        backward = ends.get((image[m.end], image[m.start]))
+        other = forward or backward
+        if other is None or (other.elements, other.E, other.rho, other.nu, other.area,
+                             other.inertia, other.depth) != (
+                m.elements, m.E, m.rho, m.nu, m.area, m.inertia, m.depth):
+            return None
+        out[m.id] = (other.id, forward is None)
+    return out
+
+
 def _mark(model: FrameModel, name: str, params: dict):
     """(name, (x, y), label, member polyline or None) of an effect found on a frame: a crack
     or a mass at its place on its member, a joint spring just off its joint along its

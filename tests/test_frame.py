@@ -1340,3 +1340,25 @@ def test_a_members_elements_together_are_each_element_alone():
     assert untouched
     assert np.array_equal(plain.K[untouched], found.K[untouched])
     assert np.array_equal(plain.M[untouched], found.M[untouched])
+
+
+def test_mirror_members_of_symmetric_and_unsymmetric_frames():
+    """The portal and the three-storey frame are their own mirror images: each floor beam
+    its own, run the other way; each column its opposite's.  A column of another section,
+    another mesh, or a support of another type breaks the symmetry."""
+    from gfe_opt.frame_data import mirror_members
+
+    portal = portal_frame()
+    assert mirror_members(portal) == {"left-column": ("right-column", False),
+                                      "beam": ("beam", True),
+                                      "right-column": ("left-column", False)}
+    storey = mirror_members(three_storey_frame())
+    assert storey is not None and all(storey[f"floor-{i}"] == (f"floor-{i}", True)
+                                      for i in (1, 2, 3))
+    left = portal.members[0]
+    for changed in (replace(left, inertia=2 * left.inertia),
+                    replace(left, elements=left.elements + 1)):
+        other = replace(portal, members=(changed, *portal.members[1:]))
+        assert mirror_members(other) is None
+    pinned = replace(portal, supports=(("A", "pinned"), *portal.supports[1:]))
+    assert mirror_members(pinned) is None
