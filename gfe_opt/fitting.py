@@ -1161,8 +1161,8 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
             return False
         ea, eb = slots[owner[a]].effect, slots[owner[b]].effect
         key = names[a].split(".", 1)[1]
-        if ea.name != eb.name or key != names[b].split(".", 1)[1] \
-                or ea.parameter(key).rule != "positive":
+        if ea.name != eb.name or key != names[b].split(".", 1)[1] or "[" in key \
+                or ea.parameter(key).rule != "positive":   # (a profile's ratios[i]: not a size)
             return False
         g = np.zeros(m)
         g[a], g[b] = sizes[a][1], sizes[b][1]
