@@ -602,12 +602,19 @@ FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "member_shear": (None, "tab:pink"), "mass_profile": (None, "tab:purple")}
 
 
-def frame_findings(members, marks, failing, title):
+def frame_findings(members, marks, failing, title, caveats=()):
     """A frame diagnosis drawn on the frame (grey): the effects found, each numbered at its
     place (``marks``: (effect name, (x, y), label, member polyline or None)) and listed
-    with its values below, and the sensors where the model as it stands fails most
-    (``failing``: ((x, y), label), hollow circles); titled with the verdict."""
-    lines = max(len(marks), 1)
+    with its values below, then ``caveats`` (sentences, in grey: what the data do not
+    decide), and the sensors where the model as it stands fails most (``failing``:
+    ((x, y), label), hollow circles); titled with the verdict."""
+    import textwrap
+
+    wrapped = [textwrap.fill(c, 120) for c in caveats]
+    below = [(f"{i}: {label}", FRAME_MARKS.get(name, ("*", "tab:green"))[1])
+             for i, (name, _, label, _) in enumerate(marks, 1)] or [("no effect found", "k")]
+    below += [(c, "0.35") for c in wrapped]
+    lines = max(sum(text.count("\n") + 1 for text, _ in below), 1)
     fig = _figure(6.4, 4.4 + 0.22 * lines)
     ax, listing = fig.subplots(2, 1, height_ratios=(4.4, 0.22 * lines))
     listing.set_axis_off()
@@ -617,7 +624,7 @@ def frame_findings(members, marks, failing, title):
                    zorder=3, label="where the model as it stands fails most" if i == 0 else None)
         ax.annotate(label, (x, y), fontsize=6.5, color="0.25", xytext=(0, -13),
                     textcoords="offset points", ha="center")
-    for i, (name, (x, y), label, line) in enumerate(marks, 1):
+    for i, (name, (x, y), _, line) in enumerate(marks, 1):
         marker, colour = FRAME_MARKS.get(name, ("*", "tab:green"))
         if line is not None:
             ax.plot(line[:, 0], line[:, 1], color=colour, lw=4, alpha=0.7, zorder=2)
@@ -626,11 +633,11 @@ def frame_findings(members, marks, failing, title):
                        edgecolors="k", linewidths=0.5)
         ax.annotate(str(i), (x, y), fontsize=9, color=colour, fontweight="bold",
                     xytext=(7, 5), textcoords="offset points", zorder=5)
-        listing.text(0.0, 1.0 - (i - 1) / lines, f"{i}: {label}", fontsize=8, color=colour,
-                     va="top", transform=listing.transAxes)
-    if not marks:
-        listing.text(0.0, 1.0, "no effect found", fontsize=8, va="top",
-                     transform=listing.transAxes)
+    row = 0
+    for text, colour in below:
+        listing.text(0.0, 1.0 - row / lines, text, fontsize=8 if colour != "0.35" else 7,
+                     color=colour, va="top", transform=listing.transAxes)
+        row += text.count("\n") + 1
     if failing:
         ax.legend(fontsize=7, loc="upper right", bbox_to_anchor=(1.0, 1.12), frameon=False)
     ax.margins(0.12)

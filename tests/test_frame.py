@@ -1362,3 +1362,30 @@ def test_mirror_members_of_symmetric_and_unsymmetric_frames():
         assert mirror_members(other) is None
     pinned = replace(portal, supports=(("A", "pinned"), *portal.supports[1:]))
     assert mirror_members(pinned) is None
+
+
+def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
+    """The figure of a frame diagnosis lists under its findings the notes that say what the
+    data leave open (a sum told and not its split, another assignment or place that fits
+    as well), in the notes' own words, and no other note."""
+    from types import SimpleNamespace
+
+    from gfe_opt import plots
+    from gfe_opt.frame_data import frame_diagnosis_figures
+
+    said = {}
+    monkeypatch.setattr(plots, "frame_findings",
+                        lambda members, marks, failing, title, caveats=(): said.update(
+                            caveats=list(caveats)))
+    notes = ["joint_spring with a further joint_spring brings the misfit to the noise",
+             "the data fix the sum of the two joint_springs' stiffness, 4007 ± 43 N m/rad, "
+             "not how it splits between them (each ± above is taken along that trade)",
+             "the frequencies fit as well with joint_spring: node = C — the frequencies "
+             "cannot tell these apart",
+             "the crack on beam at 0.0962 m fits as well at its mirror image, beam at "
+             "0.3038 m (χ²/n 2.44; the frame is symmetric): the frequencies cannot tell "
+             "the two places apart",
+             "no mode shapes: modes paired by frequency"]
+    frame_diagnosis_figures(SimpleNamespace(notes=notes, localisation=[]), portal_frame(),
+                            "title", [])
+    assert said["caveats"] == notes[1:4]
