@@ -1156,8 +1156,8 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
         on a symmetric portal, whose two beam ends move every frequency alike to first
         order).  Told, with the sum's σ, when that σ does not exceed the sum (as any size's
         must not); beams keep the stricter rule their campaign judged."""
-        if T is not None or base.kind != "frame" or owner[a] == owner[b] or held[a] \
-                or held[b]:
+        if T is not None or getattr(base, "kind", None) != "frame" or owner[a] == owner[b] \
+                or held[a] or held[b]:
             return False
         ea, eb = slots[owner[a]].effect, slots[owner[b]].effect
         key = names[a].split(".", 1)[1]
