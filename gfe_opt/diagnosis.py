@@ -1560,20 +1560,29 @@ def _mirror(fit, measured, noise, C, sel) -> str | None:
     sigma = sigma if np.isfinite(sigma) else 0.0
     if x is None or abs(model.length - 2 * x) <= max(2 * sigma, 1e-3 * model.length):
         return None
-    effects = list(fit.effects)
-    effects[fit.added] = Effect(added.name, {**added.parameters, "position": model.length - x})
-    try:
-        other = model.with_effects(effects)
-    except GfeInputError:
-        return None
-    chi2 = misfit(other, measured, noise, C).chi2
-    if chi2 - fit.misfit.chi2 >= ALIKE_CHI2 * sel.floor:
+    chi2 = _alike_at(fit, model.length - x, measured, noise, C, sel)
+    if chi2 is None:
         return None
     fit.mirror_position = model.length - x
     return (f"the {added.name} at x = {x:.4g} m fits as well at its mirror image "
             f"x = {model.length - x:.4g} m (χ²/n {chi2 / max(fit.misfit.n_residuals, 1):.3g}):"
             f" the {'frequencies' if measured.frequency_only else 'data'} cannot tell the two "
             "places apart")
+
+
+def _alike_at(fit, position, measured, noise, C, sel) -> float | None:
+    """χ² of ``fit`` with its added effect moved to ``position`` (its other parameters
+    kept), when within :data:`ALIKE_CHI2` noise floors of the fit's own; else None (or
+    when the place is not allowed)."""
+    added = fit.effects[fit.added]
+    effects = list(fit.effects)
+    effects[fit.added] = Effect(added.name, {**added.parameters, "position": position})
+    try:
+        other = fit.model.with_effects(effects)
+    except GfeInputError:
+        return None
+    chi2 = misfit(other, measured, noise, C).chi2
+    return None if chi2 - fit.misfit.chi2 >= ALIKE_CHI2 * sel.floor else chi2
 
 
 def _frame_mirror(fit, measured, noise, C, sel) -> str | None:
@@ -1599,14 +1608,8 @@ def _frame_mirror(fit, measured, noise, C, sel) -> str | None:
     sigma = sigma if np.isfinite(sigma) else 0.0
     if abs(length - 2 * x) <= max(2 * sigma, 0.02 * length):
         return None
-    effects = list(fit.effects)
-    effects[fit.added] = Effect(added.name, {**added.parameters, "position": length - x})
-    try:
-        other = model.with_effects(effects)
-    except GfeInputError:
-        return None
-    chi2 = misfit(other, measured, noise, C).chi2
-    if chi2 - fit.misfit.chi2 >= ALIKE_CHI2 * sel.floor:
+    chi2 = _alike_at(fit, length - x, measured, noise, C, sel)
+    if chi2 is None:
         return None
     return (f"the {added.name} on {member} at {x:.4g} m fits as well at its mirror image, "
             f"{member} at {length - x:.4g} m (χ²/n "

@@ -834,12 +834,8 @@ def test_frequencies_alone_name_both_loose_joints_and_what_they_fix(tmp_path):
     path = tmp_path / "portal-frequencies.json"
     path.write_text(json.dumps({"modes": [{"frequency": m["frequency"]}
                                           for m in data["modes"]]}))
-    frame = str(problem_file("portal-frame.toml"))
-    run = subprocess.run([sys.executable, "-m", "gfe_opt", "diagnose", frame, str(path),
-                          "--candidates", "material,joint_spring", "--json"],
-                         capture_output=True, text=True)
-    assert run.returncode == 0, run.stderr
-    out = json.loads(run.stdout)
+    out = _diagnose_json(problem_file("portal-frame.toml"), path, "--candidates",
+                         "material,joint_spring")
     assert out["verdict"] == "effect_found"
     assert out["suggested"] == ["joint_spring", "joint_spring"]
     pair = out["together"]
@@ -871,18 +867,9 @@ def test_frequencies_alone_name_two_unequal_joints_but_not_which_is_which(tmp_pa
     exact = exact_of(model, [(n, beam, k) for n, k in truth.items()])
     joints = tuple({"effect": "joint_spring", "member": "beam", "node": n, "stiffness": k}
                    for n, k in truth.items())
-    guess = frame_modes(replace(refined(model, 64), effects=joints), 6).frequencies_hz
-    rng = np.random.default_rng(5)
-    f = [exact.frequency_near(x, 1e-4) * (1 + 0.0005 * rng.standard_normal())
-         for x in guess]
-    path = tmp_path / "portal-frequencies.json"
-    path.write_text(json.dumps({"modes": [{"frequency": float(x)} for x in f]}))
-    run = subprocess.run([sys.executable, "-m", "gfe_opt", "diagnose",
-                          str(problem_file("portal-frame.toml")), str(path),
-                          "--candidates", "material,joint_spring", "--json"],
-                         capture_output=True, text=True)
-    assert run.returncode == 0, run.stderr
-    out = json.loads(run.stdout)
+    path = _frequencies_only(tmp_path, model, exact, joints, seed=5)
+    out = _diagnose_json(problem_file("portal-frame.toml"), path, "--candidates",
+                         "material,joint_spring")
     assert out["verdict"] == "effect_found"
     assert out["suggested"] == ["joint_spring", "joint_spring"]
     pair = out["together"]
