@@ -112,8 +112,6 @@ class MeasuredModes(ModeCounts):
         return len(self.x)
 
 
-
-
 def make_measured(x, dof, frequencies_hz, shapes, source="measured",
                   damping=None) -> MeasuredModes:
     """Validate and build :class:`MeasuredModes` (modes sorted by frequency).  ``x`` empty

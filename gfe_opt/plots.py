@@ -611,10 +611,10 @@ def frame_findings(members, marks, failing, title, caveats=()):
     import textwrap
 
     wrapped = [textwrap.fill(c, 120) for c in caveats]
-    below = [(f"{i}: {label}", FRAME_MARKS.get(name, ("*", "tab:green"))[1])
-             for i, (name, _, label, _) in enumerate(marks, 1)] or [("no effect found", "k")]
-    below += [(c, "0.35") for c in wrapped]
-    lines = max(sum(text.count("\n") + 1 for text, _ in below), 1)
+    below = [(f"{i}: {label}", FRAME_MARKS.get(name, ("*", "tab:green"))[1], 8)
+             for i, (name, _, label, _) in enumerate(marks, 1)] or [("no effect found", "k", 8)]
+    below += [(c, "0.35", 7) for c in wrapped]
+    lines = max(sum(text.count("\n") + 1 for text, _, _ in below), 1)
     fig = _figure(6.4, 4.4 + 0.22 * lines)
     ax, listing = fig.subplots(2, 1, height_ratios=(4.4, 0.22 * lines))
     listing.set_axis_off()
@@ -634,9 +634,9 @@ def frame_findings(members, marks, failing, title, caveats=()):
         ax.annotate(str(i), (x, y), fontsize=9, color=colour, fontweight="bold",
                     xytext=(7, 5), textcoords="offset points", zorder=5)
     row = 0
-    for text, colour in below:
-        listing.text(0.0, 1.0 - row / lines, text, fontsize=8 if colour != "0.35" else 7,
-                     color=colour, va="top", transform=listing.transAxes)
+    for text, colour, size in below:
+        listing.text(0.0, 1.0 - row / lines, text, fontsize=size, color=colour, va="top",
+                     transform=listing.transAxes)
         row += text.count("\n") + 1
     if failing:
         ax.legend(fontsize=7, loc="upper right", bbox_to_anchor=(1.0, 1.12), frameon=False)
