@@ -215,6 +215,37 @@ class NoiseEstimate:
                 "implied_freq": self.implied_freq, "implied_shape": self.implied_shape}
 
 
+class Caveat(str):
+    """A note on what the data leave open about the finding (:attr:`Diagnosis.caveats`,
+    ``diagnose --json``'s ``caveats``): its words, its ``kind`` and the ``alternatives``
+    that fit as well, each a tuple of :class:`~gfe_opt.model.Effect` standing where the
+    finding's effects stand.  A str, so that it prints and joins as every other note does;
+    the figures and the JSON read its kind and alternatives, never its words.
+
+    Kinds: ``alike`` (another effect fits as well), ``mirror`` (the finding at its mirror
+    place), ``places`` (at other places of a frame), ``equivalent`` (other parameter sets),
+    ``split`` (a sum told, not how it splits), ``combination`` (a combination of parameters
+    told, not each), ``undecided`` (not a finding: the alternatives are why)."""
+
+    kind: str
+    alternatives: tuple
+
+    def __new__(cls, text: str, kind: str, alternatives=()):
+        self = super().__new__(cls, text)
+        self.kind = kind
+        self.alternatives = tuple(tuple(effects) for effects in alternatives)
+        return self
+
+    def __reduce__(self):
+        return (Caveat, (str(self), self.kind, self.alternatives))
+
+    def to_json(self) -> dict:
+        """``{"kind", "note", "alternatives": [[{"effect": name, parameters...}, ...]]}``."""
+        return {"kind": self.kind, "note": str(self),
+                "alternatives": [[{"effect": e.name, **jsonable(e.parameters)}
+                                  for e in effects] for effects in self.alternatives]}
+
+
 @dataclass
 class Diagnosis:
     """Ranked candidate effects (best first), the verdict and what the data imply.
@@ -278,6 +309,12 @@ class Diagnosis:
         return out
 
     @property
+    def caveats(self) -> list[Caveat]:
+        """The notes on what the data leave open about the finding (:class:`Caveat`), in
+        the order the notes give them."""
+        return [n for n in self.notes if isinstance(n, Caveat)]
+
+    @property
     def current(self) -> Misfit:
         """The misfit of the model as it stands (present effects re-estimated)."""
         return self.reference.misfit if self.reference else self.baseline
@@ -307,7 +344,8 @@ class Diagnosis:
                 "replace": None if self.replace is None else dict(self.replace),
                 "not_needed": [jsonable(d) for d in self.not_needed],
                 "realisation": list(self.realisation),
-                "notes": list(self.notes)}
+                "notes": [str(n) for n in self.notes],
+                "caveats": [c.to_json() for c in self.caveats]}
 
 
 # -------------------------------------------------------------------------------------------
@@ -971,8 +1009,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         if undecided:  # the pair is not determined: the first effect alone may still be
             said = set(equivalent_notes(together, measured))
             notes = [n for n in notes if n not in said and not n.endswith("add them together")]
-            notes.append(_undecided_note(together, undecided, measured, len(model.effects))
-                         .replace("nothing is suggested", "the pair is not suggested"))
+            notes.append(_undecided_note(together, undecided, measured, len(model.effects),
+                                         "the pair is not suggested"))
             suggested, together = [], None
     if verdict == "effect_found" and not suggested and measured.frequency_only \
             and not ranked[0].equivalent and ranked[0].added is not None:
@@ -1355,10 +1393,11 @@ def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[st
         what = "the frequencies" if measured.frequency_only else "the data"
         # with a pair suggested, the comparison is of the effects alone, not of the pair
         alone = "alone, " if together is not None else ""
-        notes.append(f"{alone}{what} cannot tell {best.name} from " + ", ".join(
+        notes.append(Caveat(f"{alone}{what} cannot tell {best.name} from " + ", ".join(
             f"{f.name} (χ²/n {f.misfit.chi2_per_residual:.3g} against "
             f"{best.misfit.chi2_per_residual:.3g})" for f in alike)
-            + (": measure mode shapes to decide" if measured.frequency_only else ""))
+            + (": measure mode shapes to decide" if measured.frequency_only else ""),
+            "alike", [(f.effects[-1 if f.added is None else f.added],) for f in alike]))
     mirror = _mirror(best, measured, noise, C, sel)
     if mirror is not None:
         notes.append(mirror)
@@ -1406,14 +1445,15 @@ def _other_places(fit, measured, noise, C, sel, together=None) -> str | None:
             close = theirs is not None and float(np.sum((theirs - mine) ** 2)) \
                 < SEPARATION * sel.floor
         if close:
-            alike[place] = chi2
+            alike[place] = (chi2, effects[fit.added])
     if not alike:
         return None
     n = max(fit.misfit.n_residuals, 1)
     what = "frequencies" if measured.frequency_only else "data"
-    return (f"the {fit.name} at {here} may as well be at " + ", ".join(
+    return Caveat(f"the {fit.name} at {here} may as well be at " + ", ".join(
         f"{place} (χ²/n {chi2 / n:.3g} against {fit.misfit.chi2_per_residual:.3g})"
-        for place, chi2 in alike.items()) + f": the {what} cannot tell these places apart")
+        for place, (chi2, _) in alike.items()) + f": the {what} cannot tell these places "
+        "apart", "places", [(effect,) for _, effect in alike.values()])
 
 
 def _other_end(effects, chi2, other, sel) -> bool:
@@ -1519,9 +1559,10 @@ def _mirrored(effects, others, length) -> bool:
     return True
 
 
-def _undecided_note(fit, undecided, measured, held) -> str:
+def _undecided_note(fit, undecided, measured, held,
+                    refused: str = "nothing is suggested") -> Caveat:
     """The finding (the fit's effects after the ``held`` ones of the model), its
-    alternatives and what measurement would decide."""
+    alternatives and what measurement would decide (``refused``: what is not suggested)."""
     what = "the frequencies" if measured.frequency_only else "the data"
     alternatives = "; or ".join(", ".join(
         f"{e.name}: {effect_type(e.name).describe(e.parameters)}" for e in effects[held:])
@@ -1534,16 +1575,18 @@ def _undecided_note(fit, undecided, measured, held) -> str:
     near = f" near x = {', '.join(f'{x:g}' for x in places)} m" if places else ""
     decide = ("mode shapes (sensors" + near + ")" if measured.frequency_only
               else "more modes, or sensors" + (near or " closer together"))
-    return (f"not a finding: {what} fit {found} as well as {alternatives}, so they do not "
-            f"determine it; nothing is suggested — {decide} would decide")
+    return Caveat(f"not a finding: {what} fit {found} as well as {alternatives}, so they "
+                  f"do not determine it; {refused} — {decide} would decide", "undecided",
+                  [effects[held:] for effects in undecided])
 
 
 def equivalent_notes(fit, measured) -> list[str]:
     """Sentences for other parameter sets that fit the data as well as ``fit``."""
     what = "the frequencies" if measured.frequency_only else "the data"
-    return [f"{what} fit as well with " + "; ".join(
+    return [Caveat(f"{what} fit as well with " + "; ".join(
         f"{e.name}: {effect_type(e.name).describe(e.parameters)}" for e in effects)
-        + f" — {what} cannot tell these apart" for effects in fit.equivalent]
+        + f" — {what} cannot tell these apart", "equivalent", [effects])
+        for effects in fit.equivalent]
 
 
 def _mirror(fit, measured, noise, C, sel) -> str | None:
@@ -1564,19 +1607,24 @@ def _mirror(fit, measured, noise, C, sel) -> str | None:
     if chi2 is None:
         return None
     fit.mirror_position = model.length - x
-    return (f"the {added.name} at x = {x:.4g} m fits as well at its mirror image "
-            f"x = {model.length - x:.4g} m (χ²/n {chi2 / max(fit.misfit.n_residuals, 1):.3g}):"
-            f" the {'frequencies' if measured.frequency_only else 'data'} cannot tell the two "
-            "places apart")
+    return Caveat(
+        f"the {added.name} at x = {x:.4g} m fits as well at its mirror image "
+        f"x = {model.length - x:.4g} m (χ²/n {chi2 / max(fit.misfit.n_residuals, 1):.3g}): "
+        f"the {'frequencies' if measured.frequency_only else 'data'} cannot tell the two "
+        "places apart", "mirror", [(_moved(added, model.length - x),)])
+
+
+def _moved(effect: Effect, position: float) -> Effect:
+    """``effect`` at ``position`` (its other parameters kept)."""
+    return Effect(effect.name, {**effect.parameters, "position": position})
 
 
 def _alike_at(fit, position, measured, noise, C, sel) -> float | None:
     """χ² of ``fit`` with its added effect moved to ``position`` (its other parameters
     kept), when within :data:`ALIKE_CHI2` noise floors of the fit's own; else None (or
     when the place is not allowed)."""
-    added = fit.effects[fit.added]
     effects = list(fit.effects)
-    effects[fit.added] = Effect(added.name, {**added.parameters, "position": position})
+    effects[fit.added] = _moved(fit.effects[fit.added], position)
     try:
         other = fit.model.with_effects(effects)
     except GfeInputError:
@@ -1611,11 +1659,12 @@ def _frame_mirror(fit, measured, noise, C, sel) -> str | None:
     chi2 = _alike_at(fit, length - x, measured, noise, C, sel)
     if chi2 is None:
         return None
-    return (f"the {added.name} on {member} at {x:.4g} m fits as well at its mirror image, "
-            f"{member} at {length - x:.4g} m (χ²/n "
-            f"{chi2 / max(fit.misfit.n_residuals, 1):.3g}; the frame is symmetric): the "
-            f"{'frequencies' if measured.frequency_only else 'data'} cannot tell the two "
-            "places apart")
+    return Caveat(
+        f"the {added.name} on {member} at {x:.4g} m fits as well at its mirror image, "
+        f"{member} at {length - x:.4g} m (χ²/n {chi2 / max(fit.misfit.n_residuals, 1):.3g};"
+        f" the frame is symmetric): the "
+        f"{'frequencies' if measured.frequency_only else 'data'} cannot tell the two "
+        "places apart", "mirror", [(_moved(added, length - x),)])
 
 
 def _noise_estimate(model, measured, noise, fits, C, ref_misfit, floor) -> NoiseEstimate:
@@ -1812,14 +1861,16 @@ def traded_note(fit) -> str:
     told = fit.told[fit.added] if fit.added is not None and fit.told else {}
     if told and all(key.endswith(" sum") for key in told):
         # two instances' sizes trading (:func:`~gfe_opt.fitting._uncertainty`'s told sums)
-        return "; ".join(f"the data fix {t['label']}, {t['value']:.4g} ± {t['sigma']:.2g} "
-                         f"{t['unit']}, not how it splits between them"
-                         for t in told.values()) + " (each ± above is taken along that trade)"
+        return Caveat("; ".join(f"the data fix {t['label']}, {t['value']:.4g} ± "
+                                f"{t['sigma']:.2g} {t['unit']}, not how it splits between "
+                                "them" for t in told.values())
+                      + " (each ± above is taken along that trade)", "split")
     said = "; ".join(f"{t['label']} = {t['value']:.3g} ± {t['sigma']:.2g} {t['unit']}"
                      for t in told.values())
-    return (f"{fit.name}: " + "; ".join(fit.traded) + ": the data fix their combination ("
-            + (said or "a zone's added compliance ℓ (1/r − 1) and mass ℓ (m − 1)")
-            + "), not each value; each ± is taken along that trade")
+    return Caveat(f"{fit.name}: " + "; ".join(fit.traded) + ": the data fix their "
+                  "combination (" + (said or "a zone's added compliance ℓ (1/r − 1) and mass "
+                                     "ℓ (m − 1)")
+                  + "), not each value; each ± is taken along that trade", "combination")
 
 
 def drop_indices(model: Model, drop) -> set:

@@ -554,16 +554,16 @@ def frame_diagnosis_figures(diagnosis, model: FrameModel, title: str, found) -> 
     for sensor, _ in diagnosis.localisation or []:
         point, _ = sensor_places(model, [sensor])
         failing.append((tuple(point[0]), sensor_label(sensor)))
-    # what the data do not decide about the finding, in the notes' own words: a sum told
-    # and not its split, another assignment or place that fits as well
-    caveats = [n for n in diagnosis.notes if any(key in n for key in CAVEATS)]
+    # what the data do not decide about the finding (the diagnosis's caveats, in their own
+    # words) and where else its effect fits as well (their alternatives, drawn hollow)
+    caveats = diagnosis.caveats
+    elsewhere = [_mark(model, e.name, e.parameters) for c in caveats
+                 if c.kind in ("mirror", "places", "alike")
+                 for effects in c.alternatives for e in effects
+                 if "member" in e.parameters or "node" in e.parameters]
     return {"frame_diagnosis.png": plots.frame_findings(members, marks, failing, title,
-                                                        caveats)}
-
-
-#: phrases of the diagnosis notes that the frame's figure repeats under its findings
-CAVEATS = ("not how it splits between them", "cannot tell these apart",
-           "cannot tell these places apart", "cannot tell the two places apart")
+                                                        [str(c) for c in caveats],
+                                                        elsewhere)}
 
 
 def effect_place(model: FrameModel, effect) -> str:

@@ -49,11 +49,11 @@ def parameter_changes(curves, *, quantity: str, title: str, crack_position=None)
 
 
 def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pinned"),
-                      places=(), findings=()):
+                      places=(), findings=(), elsewhere=()):
     """The generic update's k_i / k_i0 along the structure with its ±3σ noise band, the
     features beyond it labelled, and, when an effect was found, what the update reads
     from that effect's own modes; below, the structure with the located place and the
-    fitted effects (``findings`` as for :func:`structure_sketch`)."""
+    fitted effects (``findings`` and ``elsewhere`` as for :func:`structure_sketch`)."""
     fig = _figure(7.0, 4.6 if length is not None else 3.6)
     if length is not None:
         ax, sketch = fig.subplots(2, 1, sharex=True, height_ratios=(3.4, 1.1))
@@ -64,7 +64,8 @@ def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pin
     ax.set_title("Bending stiffness read from the test at each node, over the model's",
                  fontsize=10)
     if sketch is not None:
-        structure_sketch(sketch, length, supports, places=places, findings=findings)
+        structure_sketch(sketch, length, supports, places=places, findings=findings,
+                         elsewhere=elsewhere)
         sketch.set_xlabel("x [m]")
     else:
         ax.set_xlabel("x [m]")
@@ -201,11 +202,12 @@ def paired_frequencies(pairs):
 
 
 def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None, places=(),
-                     findings=()):
+                     findings=(), elsewhere=()):
     """The structure as a bar on ``ax`` (x in m): its supports, the sensors, where the model
-    fails (``places``: (x, share of the largest residual)) and ``findings``: (effect type,
-    model, parameters, σ[, parameters on a bound]) each drawn by the effect's own
-    ``mark``."""
+    fails (``places``: (x, share of the largest residual)), ``findings``: (effect type,
+    model, parameters, σ[, parameters on a bound]) each drawn by the effect's own ``mark``,
+    and, hollow with "or", where an effect fits as well (``elsewhere``: (x, effect name),
+    the diagnosis's caveats)."""
     ax.plot([0, length], [0, 0], lw=6, color="0.4", solid_capstyle="butt")
     if sensors is not None and len(sensors):
         ax.plot(sensors, np.zeros_like(np.asarray(sensors, float)), "|", color="white",
@@ -222,6 +224,11 @@ def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None,
                         color="tab:purple")
     for k, (effect, model, params, sigma, *bounds) in enumerate(findings):  # a pair: 2 levels
         effect.mark(ax, model, params, sigma, 0.35 + 0.5 * k, *bounds)
+    for k, (x, name) in enumerate(elsewhere):
+        ax.plot([x], [0.35], marker="o", ms=9, mfc="none", mec="0.3", mew=1.2)
+        ax.annotate(f"or {name} here (fits as well)" if k == 0 else f"or {name}", (x, 0.35),
+                    textcoords="offset points", xytext=(0, 8), ha="center", fontsize=7,
+                    color="0.3")
     ax.set_yticks([])
     ax.set_ylim(-1.2, 1.2)
     ax.set_xlim(-0.04 * length, 1.04 * length)
@@ -251,10 +258,10 @@ def localisation(x, residual, comac, length, supports=("pinned", "pinned"), plac
 
 
 def candidate_errors(fits, baseline_pct, together=None, verdict=None, *, length=None,
-                     supports=("pinned", "pinned"), findings=()):
+                     supports=("pinned", "pinned"), findings=(), elsewhere=()):
     """Frequency error left by each candidate effect (significant ones coloured) and, when
-    a pair is suggested, by the pair (hatched, on top); with ``findings`` (as for
-    :func:`structure_sketch`) and the ``length``, the structure with them below."""
+    a pair is suggested, by the pair (hatched, on top); with ``findings`` and ``elsewhere``
+    (as for :func:`structure_sketch`) and the ``length``, the structure with them below."""
     sketch = None
     if findings and length is not None:
         fig = _figure(7.0, 4.4)
@@ -287,7 +294,7 @@ def candidate_errors(fits, baseline_pct, together=None, verdict=None, *, length=
         fig.suptitle(f"verdict: {verdict}", fontsize=10, fontweight="bold")
     ax.legend(fontsize=8)
     if sketch is not None:
-        structure_sketch(sketch, length, supports, findings=findings)
+        structure_sketch(sketch, length, supports, findings=findings, elsewhere=elsewhere)
         sketch.set_xlabel("x [m]: the effects found")
     return fig
 
@@ -602,11 +609,12 @@ FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "member_shear": (None, "tab:pink"), "mass_profile": (None, "tab:purple")}
 
 
-def frame_findings(members, marks, failing, title, caveats=()):
+def frame_findings(members, marks, failing, title, caveats=(), elsewhere=()):
     """A frame diagnosis drawn on the frame (grey): the effects found, each numbered at its
     place (``marks``: (effect name, (x, y), label, member polyline or None)) and listed
     with its values below, then ``caveats`` (sentences, in grey: what the data do not
-    decide), and the sensors where the model as it stands fails most (``failing``:
+    decide) and, hollow with "or", the places where an effect fits as well (``elsewhere``,
+    as ``marks``), and the sensors where the model as it stands fails most (``failing``:
     ((x, y), label), hollow circles); titled with the verdict."""
     import textwrap
 
@@ -633,12 +641,21 @@ def frame_findings(members, marks, failing, title, caveats=()):
                        edgecolors="k", linewidths=0.5)
         ax.annotate(str(i), (x, y), fontsize=9, color=colour, fontweight="bold",
                     xytext=(7, 5), textcoords="offset points", zorder=5)
+    for k, (name, (x, y), _, line) in enumerate(elsewhere):
+        marker, colour = FRAME_MARKS.get(name, ("*", "tab:green"))
+        if line is not None:
+            ax.plot(line[:, 0], line[:, 1], color=colour, lw=4, alpha=0.3, ls=":", zorder=2)
+        ax.scatter([x], [y], marker=marker or "o", s=90, facecolors="none",
+                   edgecolors=colour, linewidths=1.2, zorder=4,
+                   label="fits as well (the notes below)" if k == 0 else None)
+        ax.annotate("or", (x, y), fontsize=7, color=colour, xytext=(7, -9),
+                    textcoords="offset points", zorder=5)
     row = 0
     for text, colour, size in below:
         listing.text(0.0, 1.0 - row / lines, text, fontsize=size, color=colour, va="top",
                      transform=listing.transAxes)
         row += text.count("\n") + 1
-    if failing:
+    if failing or elsewhere:
         ax.legend(fontsize=7, loc="upper right", bbox_to_anchor=(1.0, 1.12), frameon=False)
     ax.margins(0.12)
     ax.set_title(title, fontsize=10, fontweight="bold", loc="left")

@@ -39,6 +39,20 @@ def findings(diagnosis, model) -> list:
             for i, (e, s) in enumerate(zip(fit.effects, fit.sigma)) if i >= held]
 
 
+def elsewhere(diagnosis) -> list:
+    """Where on a beam or bar an effect fits as well as the one found (its mirror place,
+    another effect's place: the diagnosis's caveats), as (x, effect name)."""
+    out = []
+    for c in diagnosis.caveats:
+        if c.kind in ("mirror", "alike"):
+            for effects in c.alternatives:
+                for e in effects:
+                    x = effect_type(e.name).position(e.parameters)
+                    if isinstance(x, (int, float)):
+                        out.append((float(x), e.name))
+    return out
+
+
 def verdict_title(diagnosis) -> str:
     """``crack missing``, else the verdict in the words the text prints."""
     from .text import VERDICT_WORDS
@@ -72,13 +86,14 @@ def diagnosis_figures(diagnosis, model) -> dict:
     figs = {"candidates.png": plots.candidate_errors(
         diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
         verdict=verdict_title(diagnosis), length=model.length, supports=model.supports,
-        findings=found)} if diagnosis.fits else {}
+        findings=found, elsewhere=elsewhere(diagnosis))} if diagnosis.fits else {}
     band = diagnosis.profile_band
     best = diagnosis.best
     if band is not None:
         figs["stiffness_change.png"] = plots.profile_with_band(
             band, label=best.name if best else None, length=model.length,
-            supports=model.supports, places=diagnosis.localisation or (), findings=found)
+            supports=model.supports, places=diagnosis.localisation or (), findings=found,
+            elsewhere=elsewhere(diagnosis))
         if best is not None:
             figs.update(effect_type(best.name).figures(model, best.parameters, band))
     if diagnosis.nodal:

@@ -77,9 +77,12 @@ least needed first.  Scored as the beam campaign:
   ``consistent`` with nothing added is right too (counted as ``undetectable``);
 * **verdict right**: class right and the last verdict ``consistent`` (``unexplained`` too
   for the line-spring crack, which the package cannot represent exactly);
-* a case found at another place with a note that the truth's place fits as well ("cannot
-  tell these places apart": a symmetric portal's other corner) is not right; it is counted
-  apart (``wrong_place_said_ambiguous``).
+* a case found at another place with a caveat that the truth's place fits as well (a
+  symmetric portal's other corner, a member's mirror place) is not right; it is counted
+  apart (``wrong_place_said_ambiguous``), and so is one found as another effect with a
+  caveat naming the truth among the effects the data cannot tell from it
+  (``wrong_effect_said_alike``).  The caveats are read as ``diagnose --json`` gives them
+  (their kind and alternatives, matched as a finding is), not from the notes' words.
 
 Prints a line per case and one JSON document (``--json`` writes it too).
 """
@@ -393,11 +396,11 @@ def frequencies_only(case: dict) -> dict:
 
 def run_case(case: dict) -> dict:
     model, measured, noise = case["model"], case["measured"], case["noise"]
-    said = []
+    caveats = []
 
-    def recording(*args, **kwargs):   # the place notes of every diagnosis of the loop
+    def recording(*args, **kwargs):   # the caveats of every diagnosis of the loop
         d = diagnose(*args, **kwargs)
-        said.extend(n for n in d.notes if "cannot tell these places apart" in n)
+        caveats.extend(c for c in d.caveats if c.kind in ("mirror", "places", "alike"))
         return d
 
     bench_diagnosis.diagnose = recording
@@ -408,16 +411,20 @@ def run_case(case: dict) -> dict:
     verdicts, added = row["verdicts"], row["added"]
     found = list(model.effects)
     matched, unmatched, size_err, pos_err = [], list(found), [], []
-    ambiguous = []   # found elsewhere, with the truth's place said to fit as well
+    # found wrong, with the truth among what the diagnosis said fits as well: at another
+    # place (its mirror image, another corner) or another effect (the caveats'
+    # alternatives, read as the JSON gives them, not from the notes' words)
+    ambiguous, alike = [], []
     for answer in case["answers"]:
         hit = next((e for e in unmatched if _matches(case["model"], e, answer)), None)
         matched.append(hit is not None)
-        if hit is None and "node" in answer:
-            other = next((e for e in unmatched if e.name == answer["name"]), None)
-            if other is not None and any(f"may as well be at node {answer['node']}" in n
-                                         or f", node {answer['node']}" in n for n in said):
-                ambiguous.append(answer["name"])
-                unmatched.remove(other)
+        said = {c.kind for c in caveats for effects in c.alternatives for e in effects
+                if _matches(case["model"], e, answer)}
+        if hit is None and said and unmatched:
+            # the effect found in its stead: of its kind if one is, else the first
+            other = next((e for e in unmatched if e.name == answer["name"]), unmatched[0])
+            (alike if said == {"alike"} else ambiguous).append(answer["name"])
+            unmatched.remove(other)
         if hit is not None:
             unmatched.remove(hit)
             if answer["name"] != "crack":
@@ -429,8 +436,9 @@ def run_case(case: dict) -> dict:
     undetectable = bool(case["answers"] and case["stated"] and first_chi2 < DETECTABLE
                         and not found)
     class_right = (all(matched) and not unmatched) or undetectable
-    said_ambiguous = bool(ambiguous) and len(ambiguous) + sum(matched) == len(matched) \
-        and not unmatched
+    all_said = len(ambiguous) + len(alike) + sum(matched) == len(matched) and not unmatched
+    said_ambiguous = bool(ambiguous) and all_said
+    said_alike = bool(alike) and not ambiguous and all_said
     last = verdicts[-1]
     ok_verdicts = ("consistent", "unexplained") if case["group"] == "crack" else ("consistent",)
     return {"name": case["name"], "group": case["group"],
@@ -441,7 +449,9 @@ def run_case(case: dict) -> dict:
             "final_effects": [{"name": e.name, **e.parameters} for e in found],
             "first_chi2_per_residual": first_chi2, "undetectable": undetectable,
             "class_right": class_right, "verdict_right": class_right and last in ok_verdicts,
-            "place_said_ambiguous": said_ambiguous, "place_notes": said,
+            "place_said_ambiguous": said_ambiguous, "effect_said_alike": said_alike,
+            "place_notes": [str(c) for c in caveats if c.kind != "alike"],
+            "alike_notes": [str(c) for c in caveats if c.kind == "alike"],
             "dropped": row.get("dropped", []), "kept": row.get("kept"),
             "false_alarm": case["group"] == "none" and bool(found),
             "size_error_pct": size_err, "position_error_pct": pos_err}
@@ -456,6 +466,7 @@ def scorecard(rows) -> dict:
                 "false_alarms": sum(r["false_alarm"] for r in rs),
                 "wrong_place_said_ambiguous": sum(r.get("place_said_ambiguous", False)
                                                   for r in rs),
+                "wrong_effect_said_alike": sum(r.get("effect_said_alike", False) for r in rs),
                 "undetectable": sum(r["undetectable"] for r in rs),
                 "size_error_pct_median": float(np.median(sizes)) if sizes else None,
                 "size_within_10pct": (100 * np.mean([s <= 10 for s in sizes]) if sizes

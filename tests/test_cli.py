@@ -111,8 +111,12 @@ def test_diagnose_json_contract(files, capsys):
     data = json.loads(capsys.readouterr().out)
     assert set(data) == {"verdict", "baseline", "noise", "effects", "failed", "skipped",
                          "indistinguishable", "suggested", "together", "realisation",
-                         "notes", "remaining", "offered", "replace", "not_needed", "add"}
+                         "notes", "remaining", "offered", "replace", "not_needed", "add",
+                         "caveats"}
     assert data["add"] == data["suggested"]   # on a beam the names themselves
+    # each caveat is one of the notes, with its kind and the effect sets that fit as well
+    assert all(c["note"] in data["notes"] and set(c) == {"kind", "note", "alternatives"}
+               for c in data["caveats"])
     assert data["indistinguishable"] == [] and data["suggested"] == ["crack"]
     assert data["replace"] is None   # the model holds no effect to replace
     assert data["not_needed"] == []  # nor one to take out

@@ -1352,27 +1352,42 @@ def test_mirror_members_of_symmetric_and_unsymmetric_frames():
 
 
 def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
-    """The figure of a frame diagnosis lists under its findings the notes that say what the
-    data leave open (a sum told and not its split, another assignment or place that fits
-    as well), in the notes' own words, and no other note."""
+    """The figure of a frame diagnosis lists under its findings the diagnosis's caveats
+    (a sum told and not its split, another assignment, a mirror place that fits as well),
+    in their own words, and draws where the finding fits as well; a note that merely
+    sounds like one (a plain sentence with the same words) is not listed: the figure reads
+    the caveats' kinds, not their words."""
     from types import SimpleNamespace
 
     from gfe_opt import plots
+    from gfe_opt.diagnosis import Caveat, Diagnosis
     from gfe_opt.frame_data import frame_diagnosis_figures
 
     said = {}
     monkeypatch.setattr(plots, "frame_findings",
-                        lambda members, marks, failing, title, caveats=(): said.update(
-                            caveats=list(caveats)))
+                        lambda members, marks, failing, title, caveats=(), elsewhere=():
+                        said.update(caveats=list(caveats), elsewhere=list(elsewhere)))
+    crack = Effect("crack", {"member": "beam", "position": 0.3038, "depth_ratio": 0.3})
     notes = ["joint_spring with a further joint_spring brings the misfit to the noise",
-             "the data fix the sum of the two joint_springs' stiffness, 4007 ± 43 N m/rad, "
-             "not how it splits between them (each ± above is taken along that trade)",
-             "the frequencies fit as well with joint_spring: node = C — the frequencies "
-             "cannot tell these apart",
-             "the crack on beam at 0.0962 m fits as well at its mirror image, beam at "
-             "0.3038 m (χ²/n 2.44; the frame is symmetric): the frequencies cannot tell "
-             "the two places apart",
+             Caveat("the data fix the sum of the two joint_springs' stiffness, 4007 ± 43 "
+                    "N m/rad, not how it splits between them", "split"),
+             Caveat("the frequencies fit as well with joint_spring: node = C — the "
+                    "frequencies cannot tell these apart", "equivalent",
+                    [[Effect("joint_spring", {"node": "C", "member": "beam",
+                                              "stiffness": 1000.0})]]),
+             Caveat("the crack on beam at 0.0962 m fits as well at its mirror image, beam "
+                    "at 0.3038 m: the frequencies cannot tell the two places apart",
+                    "mirror", [[crack]]),
+             "a plain note: the frequencies cannot tell these places apart",
              "no mode shapes: modes paired by frequency"]
-    frame_diagnosis_figures(SimpleNamespace(notes=notes, localisation=[]), portal_frame(),
-                            "title", [])
-    assert said["caveats"] == notes[1:4]
+    stand_in = SimpleNamespace(notes=notes, localisation=[])
+    stand_in.caveats = Diagnosis.caveats.fget(stand_in)
+    portal = portal_frame()
+    frame_diagnosis_figures(stand_in, portal, "title", [])
+    assert said["caveats"] == [str(n) for n in notes[1:4]]
+    # the mirror place drawn hollow where the crack would be: 0.3038 m along the beam
+    (name, (x, y), _, _), = said["elsewhere"]
+    beam = portal.member("beam")
+    (x0, y0), (x1, y1) = portal.nodes[beam.start], portal.nodes[beam.end]
+    t = 0.3038 / portal.member_length(beam)
+    assert name == "crack" and np.allclose((x, y), (x0 + t * (x1 - x0), y0 + t * (y1 - y0)))

@@ -785,6 +785,13 @@ def test_frequencies_alone_say_a_crack_on_the_beam_may_be_at_its_mirror_place():
     here, mirror = (float(v) for v in notes[0].groups())
     assert abs(here + mirror - 0.4) < 1e-3
     assert min(abs(here - truth["position"]), abs(mirror - truth["position"])) < 0.02 * 0.4
+    # the same caveat as the JSON gives it: its kind and the crack at the mirror place
+    caveat, = [c for c in d.to_json()["caveats"] if c["kind"] == "mirror"]
+    assert caveat["note"] == notes[0].group(0)
+    (other,), = caveat["alternatives"]
+    assert other["effect"] == "crack" and other["member"] == "beam"
+    assert abs(other["position"] - mirror) < 1e-3
     with_shapes = diagnose(case["model"], case["measured"], candidates=["crack"],
                            **case["noise"])
     assert not any("mirror image" in n for n in with_shapes.notes)
+    assert not any(c.kind == "mirror" for c in with_shapes.caveats)

@@ -102,6 +102,14 @@ def test_a_cracks_mirror_image_is_named_not_guessed(start):
     assert min(abs(found - position), abs(found - (L - position))) < 0.02 * L
     assert d.best.mirror_position == pytest.approx(L - found, abs=1e-6)
     assert any("mirror" in n for n in d.notes), d.notes
+    # the caveat the text prints is the one the JSON and the figures read: the crack at
+    # the mirror place, drawn hollow on the structure under the candidates
+    caveat, = [c for c in d.caveats if c.kind == "mirror"]
+    assert caveat in d.notes and caveat in [c["note"] for c in d.to_json()["caveats"]]
+    (other,), = caveat.alternatives
+    assert other.name == "crack" and other.parameters["position"] == pytest.approx(L - found)
+    from gfe_opt.report import elsewhere
+    assert elsewhere(d) == [(pytest.approx(L - found), "crack")]
 
 
 @pytest.mark.slow   # 40 s: the suite's 10 minutes; a frequency-only diagnosis runs in
