@@ -240,9 +240,10 @@ class Caveat(str):
         return (Caveat, (str(self), self.kind, self.alternatives))
 
     def to_json(self) -> dict:
-        """``{"kind", "note", "alternatives": [[{"effect": name, parameters...}, ...]]}``."""
+        """``{"kind", "note", "alternatives": [[{"effect", "parameters"}, ...], ...]}`` (each
+        alternative as an entry of ``equivalent``)."""
         return {"kind": self.kind, "note": str(self),
-                "alternatives": [[{"effect": e.name, **jsonable(e.parameters)}
+                "alternatives": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
                                   for e in effects] for effects in self.alternatives]}
 
 

@@ -641,15 +641,17 @@ def frame_findings(members, marks, failing, title, caveats=(), elsewhere=()):
                        edgecolors="k", linewidths=0.5)
         ax.annotate(str(i), (x, y), fontsize=9, color=colour, fontweight="bold",
                     xytext=(7, 5), textcoords="offset points", zorder=5)
-    for k, (name, (x, y), _, line) in enumerate(elsewhere):
+    for name, (x, y), _, line in elsewhere:
         marker, colour = FRAME_MARKS.get(name, ("*", "tab:green"))
         if line is not None:
             ax.plot(line[:, 0], line[:, 1], color=colour, lw=4, alpha=0.3, ls=":", zorder=2)
         ax.scatter([x], [y], marker=marker or "o", s=90, facecolors="none",
-                   edgecolors=colour, linewidths=1.2, zorder=4,
-                   label="fits as well (the notes below)" if k == 0 else None)
-        ax.annotate("or", (x, y), fontsize=7, color=colour, xytext=(7, -9),
+                   edgecolors=colour, linewidths=1.2, zorder=4)
+        ax.annotate(f"or {name}", (x, y), fontsize=7, color=colour, xytext=(7, -10),
                     textcoords="offset points", zorder=5)
+    if elsewhere:   # one legend entry for them all, whatever their markers
+        ax.scatter([], [], marker="o", s=90, facecolors="none", edgecolors="0.3",
+                   linewidths=1.2, label='hollow, "or": fits as well (the notes below)')
     row = 0
     for text, colour, size in below:
         listing.text(0.0, 1.0 - row / lines, text, fontsize=size, color=colour, va="top",

@@ -789,8 +789,8 @@ def test_frequencies_alone_say_a_crack_on_the_beam_may_be_at_its_mirror_place():
     caveat, = [c for c in d.to_json()["caveats"] if c["kind"] == "mirror"]
     assert caveat["note"] == notes[0].group(0)
     (other,), = caveat["alternatives"]
-    assert other["effect"] == "crack" and other["member"] == "beam"
-    assert abs(other["position"] - mirror) < 1e-3
+    assert other["effect"] == "crack" and other["parameters"]["member"] == "beam"
+    assert abs(other["parameters"]["position"] - mirror) < 1e-3
     with_shapes = diagnose(case["model"], case["measured"], candidates=["crack"],
                            **case["noise"])
     assert not any("mirror image" in n for n in with_shapes.notes)
