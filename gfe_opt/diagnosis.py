@@ -1778,7 +1778,9 @@ class UpdateOutcome:
     def to_json(self) -> dict:
         """The ``update --json`` contract."""
         return {"before": self.before.summary(), "after": self.after.summary(),
-                "effects": [self.fit.effect_json(i) for i in range(len(self.fit.effects))]}
+                "effects": [self.fit.effect_json(i) for i in range(len(self.fit.effects))],
+                "notes": [str(n) for n in self.notes],
+                "caveats": [n.to_json() for n in self.notes if isinstance(n, Caveat)]}
 
 
 @one_blas_thread
@@ -1843,12 +1845,18 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
     if not fit.success:
         raise GfeSolverError(f"the fit of the effects did not converge (solver status "
                              f"{fit.status})")
+    # the effect added fits as well at its mirror place: said here as the diagnosis said
+    # it, or the updated model carries one of two places with a σ that knows of neither
+    mirror = None if fit.added is None else _mirror(
+        fit, measured, noise, C, _Selection(fit.misfit.chi2, fit.n_params, 1,
+                                            measured.n_modes, _floor([fit])))
     return UpdateOutcome(before=before, after=fit.misfit, model=fit.model, fit=fit,
                          added=list(range(len(model.effects), len(fit.effects))),
                          notes=[*taken, *dropped, *equivalent_notes(fit, measured),
                                 *(["not estimable from these data: " + u
                                    for u in fit.unidentified]),
-                                *([traded_note(fit)] if fit.traded else [])])
+                                *([traded_note(fit)] if fit.traded else []),
+                                *([mirror] if mirror is not None else [])])
 
 
 def _traded_notes(fit) -> list[str]:

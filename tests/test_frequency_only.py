@@ -110,6 +110,13 @@ def test_a_cracks_mirror_image_is_named_not_guessed(start):
     assert other.name == "crack" and other.parameters["position"] == pytest.approx(L - found)
     from gfe_opt.report import elsewhere
     assert elsewhere(d) == [(pytest.approx(L - found), "crack")]
+    # and update, adding the crack as suggested, says it too: the updated model holds one
+    # of two places, and its σ knows of neither
+    outcome = update(make_model(), measured, d.suggested, freq_noise=0.0003)
+    again, = [c for c in outcome.notes if getattr(c, "kind", None) == "mirror"]
+    x = outcome.model.effects[-1].parameters["position"]
+    assert again.alternatives[0][0].parameters["position"] == pytest.approx(L - x)
+    assert outcome.to_json()["caveats"] == [again.to_json()]
 
 
 @pytest.mark.slow   # 40 s: the suite's 10 minutes; a frequency-only diagnosis runs in
