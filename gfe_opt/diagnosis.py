@@ -1416,7 +1416,7 @@ def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[st
 SEPARATION = (2 * 1.6448536269514722) ** 2
 
 
-def _other_places(fit, measured, noise, C, sel, together=None) -> str | None:
+def _other_places(fit, measured, noise, C, sel, together=None) -> Caveat | None:
     """On a frame, a sentence when the added effect fits about as well at another place of
     the frame (a symmetric portal's other corner): its χ² within :data:`ALIKE_CHI2` noise
     floors of the best, or the two places' predictions so close (less than
@@ -1581,7 +1581,7 @@ def _undecided_note(fit, undecided, measured, held,
                   [effects[held:] for effects in undecided])
 
 
-def equivalent_notes(fit, measured) -> list[str]:
+def equivalent_notes(fit, measured) -> list[Caveat]:
     """Sentences for other parameter sets that fit the data as well as ``fit``."""
     what = "the frequencies" if measured.frequency_only else "the data"
     return [Caveat(f"{what} fit as well with " + "; ".join(
@@ -1590,7 +1590,7 @@ def equivalent_notes(fit, measured) -> list[str]:
         for effects in fit.equivalent]
 
 
-def _mirror(fit, measured, noise, C, sel) -> str | None:
+def _mirror(fit, measured, noise, C, sel) -> Caveat | None:
     """A sentence when the added local effect fits as well at its mirror image (x -> L - x):
     on a symmetric beam frequencies cannot tell the two apart."""
     if fit.added is None:
@@ -1634,7 +1634,7 @@ def _alike_at(fit, position, measured, noise, C, sel) -> float | None:
     return None if chi2 - fit.misfit.chi2 >= ALIKE_CHI2 * sel.floor else chi2
 
 
-def _frame_mirror(fit, measured, noise, C, sel) -> str | None:
+def _frame_mirror(fit, measured, noise, C, sel) -> Caveat | None:
     """On a frame that is its own mirror image (:func:`~gfe_opt.frame_data.mirror_members`)
     with no local effect present, a sentence when the added effect on a member that is its
     own image (a portal's beam) fits as well at its mirror place along it (x -> L - x): a
@@ -1859,12 +1859,12 @@ def update(model: Model, measured: MeasuredModes, add, *, freq_noise=None,
                                 *([mirror] if mirror is not None else [])])
 
 
-def _traded_notes(fit) -> list[str]:
+def _traded_notes(fit) -> list[Caveat]:
     """:func:`traded_note` of a fit whose parameters trade as told, else nothing."""
     return [traded_note(fit)] if fit.traded else []
 
 
-def traded_note(fit) -> str:
+def traded_note(fit) -> Caveat:
     """What a fit whose parameters trade as its effect allows (:attr:`Fit.traded`) tells:
     the combinations the data fix, with their σ (:attr:`Fit.told`, the JSON's ``told``)."""
     told = fit.told[fit.added] if fit.added is not None and fit.told else {}
