@@ -128,8 +128,8 @@ FIGURE_QUESTIONS = {
                             "generic update's stiffness against what noise alone gives, and "
                             "the fitted effects on the structure.",
     "frame_diagnosis.png": "Which effect, where on the frame? The effects found at their "
-                           "places with their values, and where the model as it stands fails "
-                           "most.",
+                           "places with their values, hollow where one fits as well, and "
+                           "where the model as it stands fails most.",
     "disturbance.png": "Is it a crack? Identified Q_i against Christides–Barr Q(x).",
     "nodal_equations.png": "What does each node's updated equation say? Stiffness and mass "
                            "ratios, axial force, foundation.",
