@@ -39,17 +39,24 @@ def findings(diagnosis, model) -> list:
             for i, (e, s) in enumerate(zip(fit.effects, fit.sigma)) if i >= held]
 
 
+def drawn_alternatives(diagnosis) -> list:
+    """The effects a figure draws hollow where the finding fits as well: the alternatives
+    of the caveats on its place (``mirror``, ``places``) and of those on its kind
+    (``alike``: not with a pair suggested, whose note compares the effects alone)."""
+    kinds = ("mirror", "places") if diagnosis.together is not None else \
+        ("mirror", "places", "alike")
+    return [e for c in diagnosis.caveats if c.kind in kinds
+            for effects in c.alternatives for e in effects]
+
+
 def elsewhere(diagnosis) -> list:
     """Where on a beam or bar an effect fits as well as the one found (its mirror place,
-    another effect's place: the diagnosis's caveats), as (x, effect name)."""
+    another effect's place: :func:`drawn_alternatives`), as (x, effect name)."""
     out = []
-    for c in diagnosis.caveats:
-        if c.kind in ("mirror", "alike"):
-            for effects in c.alternatives:
-                for e in effects:
-                    x = effect_type(e.name).position(e.parameters)
-                    if isinstance(x, (int, float)):
-                        out.append((float(x), e.name))
+    for e in drawn_alternatives(diagnosis):
+        x = effect_type(e.name).position(e.parameters)
+        if isinstance(x, (int, float)):
+            out.append((float(x), e.name))
     return out
 
 

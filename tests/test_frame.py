@@ -1378,16 +1378,25 @@ def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
              Caveat("the crack on beam at 0.0962 m fits as well at its mirror image, beam "
                     "at 0.3038 m: the frequencies cannot tell the two places apart",
                     "mirror", [[crack]]),
+             Caveat("alone, the frequencies cannot tell joint_spring from point_mass",
+                    "alike", [[Effect("point_mass", {"member": "beam", "position": 0.0,
+                                                     "mass": 0.05})]]),
              "a plain note: the frequencies cannot tell these places apart",
              "no mode shapes: modes paired by frequency"]
-    stand_in = SimpleNamespace(notes=notes, localisation=[])
+    stand_in = SimpleNamespace(notes=notes, localisation=[], together=None)
     stand_in.caveats = Diagnosis.caveats.fget(stand_in)
     portal = portal_frame()
     frame_diagnosis_figures(stand_in, portal, "title", [])
-    assert said["caveats"] == [str(n) for n in notes[1:4]]
-    # the mirror place drawn hollow where the crack would be: 0.3038 m along the beam
-    (name, (x, y), _, _), = said["elsewhere"]
+    assert said["caveats"] == [str(n) for n in notes[1:5]]
+    # the mirror place drawn hollow where the crack would be: 0.3038 m along the beam; the
+    # mass that fits as well, at the beam's start
+    (name, (x, y), _, _), (other, _, _, _) = said["elsewhere"]
     beam = portal.member("beam")
     (x0, y0), (x1, y1) = portal.nodes[beam.start], portal.nodes[beam.end]
     t = 0.3038 / portal.member_length(beam)
     assert name == "crack" and np.allclose((x, y), (x0 + t * (x1 - x0), y0 + t * (y1 - y0)))
+    assert other == "point_mass"
+    # with a pair suggested, an effect alike to its first one alone is no place of the pair
+    stand_in.together = object()
+    frame_diagnosis_figures(stand_in, portal, "title", [])
+    assert [m[0] for m in said["elsewhere"]] == ["crack"]
