@@ -224,11 +224,15 @@ def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None,
                         color="tab:purple")
     for k, (effect, model, params, sigma, *bounds) in enumerate(findings):  # a pair: 2 levels
         effect.mark(ax, model, params, sigma, 0.35 + 0.5 * k, *bounds)
+    found_at = [effect.position(params) for effect, _, params, *_ in findings]
     for k, (x, name) in enumerate(elsewhere):
         ax.plot([x], [0.35], marker="o", ms=9, mfc="none", mec="0.3", mew=1.2)
+        # above a finding's own label when it sits near the finding (another effect there)
+        near = any(isinstance(f, (int, float)) and abs(f - x) < 0.08 * length
+                   for f in found_at)
         ax.annotate(f"or {name} here (fits as well)" if k == 0 else f"or {name}", (x, 0.35),
-                    textcoords="offset points", xytext=(0, 8), ha="center", fontsize=7,
-                    color="0.3")
+                    textcoords="offset points", xytext=(0, 20 if near else 8), ha="center",
+                    fontsize=7, color="0.3")
     ax.set_yticks([])
     ax.set_ylim(-1.2, 1.2)
     ax.set_xlim(-0.04 * length, 1.04 * length)
