@@ -225,24 +225,29 @@ class Caveat(str):
     Kinds: ``alike`` (another effect fits as well), ``mirror`` (the finding at its mirror
     place), ``places`` (at other places of a frame), ``equivalent`` (other parameter sets),
     ``split`` (a sum told, not how it splits), ``combination`` (a combination of parameters
-    told, not each), ``undecided`` (not a finding: the alternatives are why)."""
+    told, not each), ``undecided`` (not a finding: the alternatives are why).  ``present``:
+    None for a caveat on the finding; for one on an effect the model holds already (its
+    mirror place), that effect's index in the model's effects, and the alternatives hold
+    it alone, where it would be instead."""
 
     kind: str
     alternatives: tuple
+    present: int | None
 
-    def __new__(cls, text: str, kind: str, alternatives=()):
+    def __new__(cls, text: str, kind: str, alternatives=(), present: int | None = None):
         self = super().__new__(cls, text)
         self.kind = kind
         self.alternatives = tuple(tuple(effects) for effects in alternatives)
+        self.present = present
         return self
 
     def __reduce__(self):
-        return (Caveat, (str(self), self.kind, self.alternatives))
+        return (Caveat, (str(self), self.kind, self.alternatives, self.present))
 
     def to_json(self) -> dict:
-        """``{"kind", "note", "alternatives": [[{"effect", "parameters"}, ...], ...]}`` (each
-        alternative as an entry of ``equivalent``)."""
-        return {"kind": self.kind, "note": str(self),
+        """``{"kind", "note", "alternatives": [[{"effect", "parameters"}, ...], ...],
+        "present"}`` (each alternative as an entry of ``equivalent``)."""
+        return {"kind": self.kind, "note": str(self), "present": self.present,
                 "alternatives": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
                                   for e in effects] for effects in self.alternatives]}
 
@@ -1070,6 +1075,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     if verdict == "effect_found":
         notes += _ambiguities(ranked[0], alike, measured, noise, C, sel,
                               together if suggested and together is not None else None)
+    notes += _present_mirrors(reference, measured, noise, C, sel)
     if measured.frequency_only:
         notes.append(measured.without_shapes_note())
         if realise:
@@ -1590,29 +1596,32 @@ def equivalent_notes(fit, measured) -> list[Caveat]:
         for effects in fit.equivalent]
 
 
-def _mirror(fit, measured, noise, C, sel) -> Caveat | None:
-    """A sentence when the added local effect fits as well at its mirror image (x -> L - x):
-    on a symmetric beam frequencies cannot tell the two apart."""
-    if fit.added is None:
+def _mirror(fit, measured, noise, C, sel, index=None) -> Caveat | None:
+    """A sentence when the added local effect (or the effect ``index`` of the fit, one
+    present before) fits as well at its mirror image (x -> L - x): on a symmetric beam
+    frequencies cannot tell the two apart."""
+    index = fit.added if index is None else index
+    if index is None:
         return None
     if structure(fit.model).discrete_places:
-        return _frame_mirror(fit, measured, noise, C, sel)
+        return _frame_mirror(fit, measured, noise, C, sel, index)
     model = fit.model
-    added = fit.effects[fit.added]
+    added = fit.effects[index]
     x = effect_type(added.name).position(added.parameters)
-    sigma = fit.uncertainty.get("position", 0.0)
-    sigma = sigma if np.isfinite(sigma) else 0.0
+    sigma = _position_sigma(fit, index)
     if x is None or abs(model.length - 2 * x) <= max(2 * sigma, 1e-3 * model.length):
         return None
-    chi2 = _alike_at(fit, model.length - x, measured, noise, C, sel)
+    chi2 = _alike_at(fit, model.length - x, measured, noise, C, sel, index)
     if chi2 is None:
         return None
-    fit.mirror_position = model.length - x
+    if index == fit.added:
+        fit.mirror_position = model.length - x
     return Caveat(
-        f"the {added.name} at x = {x:.4g} m fits as well at its mirror image "
+        f"the {_named(fit, index)} at x = {x:.4g} m fits as well at its mirror image "
         f"x = {model.length - x:.4g} m (χ²/n {chi2 / max(fit.misfit.n_residuals, 1):.3g}): "
         f"the {'frequencies' if measured.frequency_only else 'data'} cannot tell the two "
-        "places apart", "mirror", [(_moved(added, model.length - x),)])
+        "places apart", "mirror", [(_moved(added, model.length - x),)],
+        None if index == fit.added else index)
 
 
 def _moved(effect: Effect, position: float) -> Effect:
@@ -1620,12 +1629,37 @@ def _moved(effect: Effect, position: float) -> Effect:
     return Effect(effect.name, {**effect.parameters, "position": position})
 
 
-def _alike_at(fit, position, measured, noise, C, sel) -> float | None:
-    """χ² of ``fit`` with its added effect moved to ``position`` (its other parameters
-    kept), when within :data:`ALIKE_CHI2` noise floors of the fit's own; else None (or
-    when the place is not allowed)."""
+def _position_sigma(fit, index) -> float:
+    """σ of the position of the fit's effect ``index`` (0 where it has none or it is not
+    finite)."""
+    sigma = fit.sigma[index].get("position", 0.0) if index < len(fit.sigma) else 0.0
+    return float(sigma) if isinstance(sigma, (int, float)) and np.isfinite(sigma) else 0.0
+
+
+def _named(fit, index) -> str:
+    """The effect ``index`` of ``fit`` in a sentence: its name, or for one present before
+    the fit's own, ``present crack (effects[0])``."""
+    name = fit.effects[index].name
+    return name if index == fit.added else f"present {name} (effects[{index}])"
+
+
+def _present_mirrors(reference, measured, noise, C, sel) -> list[Caveat]:
+    """The present effects (``reference``: re-estimated) that fit as well at their mirror
+    places, each a caveat: a place an earlier update chose from data that could not tell
+    the two apart stays in doubt at every diagnosis, not only at the one that found it."""
+    if reference is None:
+        return []
+    return [c for c in (_mirror(reference, measured, noise, C, sel, i)
+                        for i in range(len(reference.effects))) if c is not None]
+
+
+def _alike_at(fit, position, measured, noise, C, sel, index=None) -> float | None:
+    """χ² of ``fit`` with its added effect (or its effect ``index``) moved to ``position``
+    (its other parameters kept), when within :data:`ALIKE_CHI2` noise floors of the fit's
+    own; else None (or when the place is not allowed)."""
+    index = fit.added if index is None else index
     effects = list(fit.effects)
-    effects[fit.added] = _moved(fit.effects[fit.added], position)
+    effects[index] = _moved(fit.effects[index], position)
     try:
         other = fit.model.with_effects(effects)
     except GfeInputError:
@@ -1634,7 +1668,7 @@ def _alike_at(fit, position, measured, noise, C, sel) -> float | None:
     return None if chi2 - fit.misfit.chi2 >= ALIKE_CHI2 * sel.floor else chi2
 
 
-def _frame_mirror(fit, measured, noise, C, sel) -> Caveat | None:
+def _frame_mirror(fit, measured, noise, C, sel, index) -> Caveat | None:
     """On a frame that is its own mirror image (:func:`~gfe_opt.frame_data.mirror_members`)
     with no local effect present, a sentence when the added effect on a member that is its
     own image (a portal's beam) fits as well at its mirror place along it (x -> L - x): a
@@ -1643,29 +1677,30 @@ def _frame_mirror(fit, measured, noise, C, sel) -> Caveat | None:
     from .frame_data import mirror_members
 
     model = fit.model
-    added = fit.effects[fit.added]
+    added = fit.effects[index]
     member, x = added.parameters.get("member"), added.parameters.get("position")
     if member is None or not isinstance(x, (int, float)) or any(
             "member" in e.parameters or "node" in e.parameters
-            for i, e in enumerate(fit.effects) if i != fit.added):
+            for i, e in enumerate(fit.effects) if i != index):
         return None
     images = mirror_members(model)
     if images is None or images[member] != (member, True):
         return None
     length = model.member_length(model.member(member))
-    sigma = fit.uncertainty.get("position", 0.0)
-    sigma = sigma if np.isfinite(sigma) else 0.0
+    sigma = _position_sigma(fit, index)
     if abs(length - 2 * x) <= max(2 * sigma, 0.02 * length):
         return None
-    chi2 = _alike_at(fit, length - x, measured, noise, C, sel)
+    chi2 = _alike_at(fit, length - x, measured, noise, C, sel, index)
     if chi2 is None:
         return None
     return Caveat(
-        f"the {added.name} on {member} at {x:.4g} m fits as well at its mirror image, "
+        f"the {_named(fit, index)} on {member} at {x:.4g} m fits as well at its mirror "
+        f"image, "
         f"{member} at {length - x:.4g} m (χ²/n {chi2 / max(fit.misfit.n_residuals, 1):.3g};"
         f" the frame is symmetric): the "
         f"{'frequencies' if measured.frequency_only else 'data'} cannot tell the two "
-        "places apart", "mirror", [(_moved(added, length - x),)])
+        "places apart", "mirror", [(_moved(added, length - x),)],
+        None if index == fit.added else index)
 
 
 def _noise_estimate(model, measured, noise, fits, C, ref_misfit, floor) -> NoiseEstimate:

@@ -42,10 +42,11 @@ def findings(diagnosis, model) -> list:
 def drawn_alternatives(diagnosis) -> list:
     """The effects a figure draws hollow where the finding fits as well: the alternatives
     of the caveats on its place (``mirror``, ``places``) and of those on its kind
-    (``alike``: not with a pair suggested, whose note compares the effects alone)."""
+    (``alike``: not with a pair suggested, whose note compares the effects alone); not
+    those on an effect the model holds already, which the figures do not draw."""
     kinds = ("mirror", "places") if diagnosis.together is not None else \
         ("mirror", "places", "alike")
-    return [e for c in diagnosis.caveats if c.kind in kinds
+    return [e for c in diagnosis.caveats if c.kind in kinds and c.present is None
             for effects in c.alternatives for e in effects]
 
 

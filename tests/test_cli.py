@@ -115,7 +115,7 @@ def test_diagnose_json_contract(files, capsys):
                          "caveats"}
     assert data["add"] == data["suggested"]   # on a beam the names themselves
     # each caveat is one of the notes, with its kind and the effect sets that fit as well
-    assert all(c["note"] in data["notes"] and set(c) == {"kind", "note", "alternatives"}
+    assert all(c["note"] in data["notes"] and set(c) == {"kind", "note", "alternatives", "present"}
                for c in data["caveats"])
     assert data["indistinguishable"] == [] and data["suggested"] == ["crack"]
     assert data["replace"] is None   # the model holds no effect to replace

@@ -1381,15 +1381,20 @@ def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
              Caveat("alone, the frequencies cannot tell joint_spring from point_mass",
                     "alike", [[Effect("point_mass", {"member": "beam", "position": 0.0,
                                                      "mass": 0.05})]]),
+             Caveat("the present crack (effects[0]) on beam at 0.1 m fits as well at its "
+                    "mirror image, beam at 0.3 m", "mirror",
+                    [[Effect("crack", {"member": "beam", "position": 0.3,
+                                       "depth_ratio": 0.3})]], present=0),
              "a plain note: the frequencies cannot tell these places apart",
              "no mode shapes: modes paired by frequency"]
     stand_in = SimpleNamespace(notes=notes, localisation=[], together=None)
     stand_in.caveats = Diagnosis.caveats.fget(stand_in)
     portal = portal_frame()
     frame_diagnosis_figures(stand_in, portal, "title", [])
-    assert said["caveats"] == [str(n) for n in notes[1:5]]
+    assert said["caveats"] == [str(n) for n in notes[1:6]]
     # the mirror place drawn hollow where the crack would be: 0.3038 m along the beam; the
-    # mass that fits as well, at the beam's start
+    # mass that fits as well, at the beam's start; not the present crack's mirror place (the
+    # figure does not draw the present crack)
     (name, (x, y), _, _), (other, _, _, _) = said["elsewhere"]
     beam = portal.member("beam")
     (x0, y0), (x1, y1) = portal.nodes[beam.start], portal.nodes[beam.end]

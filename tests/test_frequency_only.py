@@ -117,6 +117,14 @@ def test_a_cracks_mirror_image_is_named_not_guessed(start):
     x = outcome.model.effects[-1].parameters["position"]
     assert again.alternatives[0][0].parameters["position"] == pytest.approx(L - x)
     assert outcome.to_json()["caveats"] == [again.to_json()]
+    # and every diagnosis after it, of the model that holds the crack at one of the two
+    later = diagnose(outcome.model, measured, candidates=["crack", "material", "point_mass"],
+                     freq_noise=0.0003)
+    present, = [c for c in later.caveats if c.kind == "mirror"]
+    assert present.startswith("the present crack (effects[0]) at x = ") and present.present == 0
+    from gfe_opt.report import drawn_alternatives
+    assert drawn_alternatives(later) == []   # the figures draw the finding's, not these
+    assert present.alternatives[0][0].parameters["position"] == pytest.approx(L - x, abs=1e-3)
 
 
 @pytest.mark.slow   # 40 s: the suite's 10 minutes; a frequency-only diagnosis runs in
