@@ -402,7 +402,9 @@ def run_case(case: dict) -> dict:
     model, measured, noise = case["model"], case["measured"], case["noise"]
     caveats = []
 
-    def recording(*args, **kwargs):   # the caveats of every diagnosis of the loop
+    # the caveats of the first diagnosis (the loop's later ones run inside
+    # gfe_opt.diagnosis.follow, which this does not see)
+    def recording(*args, **kwargs):
         d = diagnose(*args, **kwargs)
         caveats.extend(d.caveats)
         return d
