@@ -443,9 +443,10 @@ def run_case(case: dict) -> dict:
                                / answer["length"])
     # two instances whose sizes the diagnosis said trade (a "split" caveat: their sum told,
     # not how it splits): scored by their sum, what the data fix and the tool claims
-    split = any(c.kind == "split" for c in caveats)
     names = [a["name"] for a, _ in sizes]
-    if split and len(sizes) == 2 and names[0] == names[1] and names[0] != "crack":
+    as_sum = any(c.kind == "split" for c in caveats) and len(sizes) == 2 \
+        and names[0] == names[1] and names[0] != "crack"
+    if as_sum:
         size_err = [100 * (sum(_size(case["model"], hit) for _, hit in sizes)
                            / sum(a["size"] for a, _ in sizes) - 1)]
     undetectable = bool(case["answers"] and case["stated"] and first_chi2 < DETECTABLE
@@ -467,7 +468,7 @@ def run_case(case: dict) -> dict:
             "place_said_ambiguous": said_ambiguous, "effect_said_alike": said_alike,
             "place_notes": [str(c) for c in caveats if c.kind in ("mirror", "places")],
             "alike_notes": [str(c) for c in caveats if c.kind == "alike"],
-            "sizes_scored_as_sum": split and len(size_err) == 1 and len(sizes) == 2,
+            "sizes_scored_as_sum": as_sum,
             "dropped": row.get("dropped", []), "kept": row.get("kept"),
             "false_alarm": case["group"] == "none" and bool(found),
             "size_error_pct": size_err, "position_error_pct": pos_err}
