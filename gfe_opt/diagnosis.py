@@ -252,6 +252,11 @@ class Caveat(str):
                                   for e in effects] for effects in self.alternatives]}
 
 
+def caveats_of(notes) -> list[Caveat]:
+    """The :class:`Caveat` notes of ``notes``, in their order (a diagnosis's, an update's)."""
+    return [n for n in notes if isinstance(n, Caveat)]
+
+
 @dataclass
 class Diagnosis:
     """Ranked candidate effects (best first), the verdict and what the data imply.
@@ -318,7 +323,7 @@ class Diagnosis:
     def caveats(self) -> list[Caveat]:
         """The notes on what the data leave open about the finding (:class:`Caveat`), in
         the order the notes give them."""
-        return [n for n in self.notes if isinstance(n, Caveat)]
+        return caveats_of(self.notes)
 
     @property
     def current(self) -> Misfit:
@@ -1815,7 +1820,7 @@ class UpdateOutcome:
         return {"before": self.before.summary(), "after": self.after.summary(),
                 "effects": [self.fit.effect_json(i) for i in range(len(self.fit.effects))],
                 "notes": [str(n) for n in self.notes],
-                "caveats": [n.to_json() for n in self.notes if isinstance(n, Caveat)]}
+                "caveats": [c.to_json() for c in caveats_of(self.notes)]}
 
 
 @one_blas_thread
