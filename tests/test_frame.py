@@ -1405,3 +1405,33 @@ def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
     stand_in.together = object()
     frame_diagnosis_figures(stand_in, portal, "title", [])
     assert [m[0] for m in said["elsewhere"]] == ["crack"]
+
+
+def test_a_timoshenko_reading_kept_for_its_mesh_is_the_one_built_anew(monkeypatch):
+    """The sensors' Timoshenko reading keeps its geometry once a mesh (a fit of shear changes
+    g alone): several κGA one after another on one mesh read exactly as each built with
+    nothing kept, the readings differ with κGA, and they tend to the Euler–Bernoulli one as
+    κGA grows (g → 0)."""
+    from gfe_opt import frame_data
+
+    model = portal_frame()
+    sensors = [{"member": m.id, "position": round(t * model.member_length(m), 4),
+                "direction": d} for m in model.members for t in (0.3, 0.7) for d in ("x", "y")]
+    sensors.append({"node": model.members[0].end, "direction": "x"})
+
+    def reading(kga):
+        m = model.with_effects([Effect("shear", {"shear_rigidity": kga})], check=False)
+        return frame_data.observation(m, frame_mesh(m), sensors).toarray()
+
+    values = (2e5, 1e6, 3e6, 1e12)
+    kept = [reading(k) for k in values]
+    monkeypatch.setattr(frame_data, "OBSERVATIONS_KEPT", 0)
+    frame_data._OBSERVATIONS.clear()
+    frame_data._SHEAR_PLACES.clear()
+    anew = [reading(k) for k in values]
+    for a, b in zip(kept, anew):
+        assert np.array_equal(a, b)
+    assert not frame_data._SHEAR_PLACES
+    plain = frame_data.build_observation(model, frame_mesh(model), sensors).toarray()
+    moved = [np.max(np.abs(r - plain)) for r in kept]
+    assert moved[0] > moved[1] > moved[2] > 1e3 * moved[3] > 0, moved
