@@ -14,13 +14,14 @@ exactly and its dynamic part through the modes.  One basis serves the whole grid
 points together differ on at most :data:`LOCAL_FRACTION` of the free DOFs (a frame
 member), else one each set of DOFs (a place along a beam; points of one place share it);
 where a basis would hold more than that fraction (a uniform change of E; a model of a few
-elements, whose basis would be the model), the grid is solved point by point as before.  Measured on the portal's and the
-three-storey frame's grids (crack, point mass, point spring, section loss, axial load,
-joint spring): χ² within 1e-9 (median) and 2e-5 (worst, relative) of the exact solve's;
-on the 46-element demo beam's (crack, point mass and spring, section loss, support spring;
-a crack's Christides–Barr disturbance, above 1e-12 of the largest entry, reaches 0.2 m
-each way: its basis there holds more than half the model) within 1e-8 and 1e-7, and on its support translation's 1.2e-4 (a grid of 5
-points, below :data:`MIN_POINTS`: solved point by point).
+elements, whose basis would be the model), the grid is solved point by point as before.
+Measured on the portal's and the three-storey frame's grids (crack, point mass, point
+spring, section loss, axial load, joint spring): χ² within 1e-9 (median) and 2e-5 (worst,
+relative) of the exact solve's; on the 46-element demo beam's (crack, point mass and
+spring, section loss, support spring; a crack's Christides–Barr disturbance, above 1e-12
+of the largest entry, reaches 0.2 m each way: its basis there holds more than half the
+model) within 1e-8 and 1e-7, and on its support translation's 1.2e-4 (a grid of 5 points,
+below :data:`MIN_POINTS`: solved point by point).
 
 The screened values only choose which points are solved exactly: every point whose
 screened χ² lies within :data:`MARGIN` of the lowest, and the :data:`SHORTLIST` lowest
@@ -46,12 +47,13 @@ from .modal import Modes, condensed, rigid_as_zero, signed, solve_modes
 #: the screen's basis (the first point's modes and the static responses) holds at most this
 #: fraction of the free DOFs, else the points are solved one by one (a small model: its
 #: solve costs what a basis would; a uniform change touches every DOF).  Measured on
-#: ``update --add crack`` (one BLAS thread, best of 3, the same fit to the last digit either
-#: way): 0.5 left a crack's grid on a beam unscreened at every mesh (its disturbance covers
-#: a fixed share of the beam); 0.75 screens it from 46 elements on, 196 → 171 ms there,
-#: 541 → 303 ms on 100 and 1.54 → 0.88 s on 180; 1.0 would screen 24 elements too, no
-#: faster (147 → 150 ms) than solving each point.  The frames' grids were screened
-#: alike under 0.5 and 0.75 (their diagnoses the same to the last digit)
+#: ``update --add crack`` (one BLAS thread, best of 3, the same fit to the last digit
+#: either way): 0.5 left a crack's grid on a beam unscreened at every mesh tried, 16 to
+#: 180 elements (its disturbance covers a fixed share of the beam); 0.75 screens it from
+#: 46 elements on, 196 → 171 ms there, 541 → 303 ms on 100 and 1.54 → 0.88 s on 180; 1.0
+#: would screen 24 elements too, no faster (147 → 150 ms) than solving each point.  The
+#: frames' grids were screened alike under 0.5 and 0.75 (their diagnoses the same to the
+#: last digit)
 LOCAL_FRACTION = 0.75
 #: points whose screened χ² lies within this fraction of the lowest are solved exactly
 #: (100 times the worst screening error measured: the module docstring)
@@ -129,6 +131,7 @@ def screen(residual, zs) -> np.ndarray | None:
     # crack's disturbance decays without end: 1e-12 of the largest entry is no change)
     tiny = [RELATIVE_CHANGE * abs(A).max() for A in (K0, M0)]
     sets = []
+    row_of = {}
     for j, model in enumerate(models):
         if j:
             try:
@@ -139,9 +142,8 @@ def screen(residual, zs) -> np.ndarray | None:
         K, M = matrices[-1]
         if K.shape != K0.shape or not np.array_equal(discs[-1].free, free):
             return None   # the mesh itself differs from point to point (a released joint)
-        rows = [D.row[np.abs(D.data) > t] for D, t in
-                ((sp.coo_matrix(K - K0), tiny[0]), (sp.coo_matrix(M - M0), tiny[1]))]
-        rows = index[np.concatenate(rows)]
+        rows = index[np.concatenate([_changed_rows(A, A0, t, row_of)
+                                     for A, A0, t in ((K, K0, tiny[0]), (M, M0, tiny[1]))])]
         sets.append(np.unique(rows[rows >= 0]))
         if n_basis + len(sets[-1]) > limit:
             # no basis serves this point (nor the grid, which holds it): solved one by one,
@@ -188,6 +190,26 @@ def screen(residual, zs) -> np.ndarray | None:
         except (*_TRIAL_ERRORS, RuntimeError):
             screened.append(FAILED_RESIDUAL**2)
     return np.array(screened)
+
+
+def _changed_rows(A, A0, tiny: float, row_of: dict) -> np.ndarray:
+    """The rows of the entries where ``A`` differs from ``A0`` by more than ``tiny`` (each
+    row once per such entry, in the order of ``A − A0``'s entries).  Where the two share
+    their sparsity pattern (a point of a grid on the first point's mesh) the entries are
+    compared in place: the same rows as the sparse difference, without building it (a third
+    of a crack grid's screen on the 46-element beam); ``row_of`` keeps each pattern's row
+    of every entry."""
+    if (sp.isspmatrix_csr(A) and sp.isspmatrix_csr(A0) and A.has_canonical_format
+            and A0.has_canonical_format and A.indptr.size == A0.indptr.size
+            and A.indices.size == A0.indices.size and np.array_equal(A.indptr, A0.indptr)
+            and np.array_equal(A.indices, A0.indices)):
+        key = (id(A0), A0.indptr.size, A0.indices.size)
+        rows = row_of.get(key)
+        if rows is None:
+            rows = row_of[key] = np.repeat(np.arange(A0.shape[0]), np.diff(A0.indptr))
+        return rows[np.abs(A.data - A0.data) > tiny]
+    D = sp.coo_matrix(A - A0)
+    return D.row[np.abs(D.data) > tiny]
 
 
 def _shortlist(values, among) -> np.ndarray:

@@ -64,12 +64,18 @@ def main(argv=None) -> int:
     grid_start, fit_group = fitting._grid_start, diagnosis._fit_group
     grid = []
 
-    def recording_grid(chi2, grids, nulls=None):
+    def recording_grid(chi2, grids, nulls=None, bulk=None):
         def seen(z):
             value = chi2(z)
             grid.append(value)
             return value
-        return grid_start(seen, grids, nulls)
+
+        def seen_in_bulk(zs, null):   # a screened grid's values (its best ones exact)
+            values = bulk(zs, null)
+            if values is not None:
+                grid.extend(values)
+            return values
+        return grid_start(seen, grids, nulls, None if bulk is None else seen_in_bulk)
 
     rows = []
 
