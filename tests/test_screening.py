@@ -121,3 +121,33 @@ def test_a_beam_grid_is_screened_place_by_place(monkeypatch, name):
         assert abs(fit.parameters["mass"] / 0.2 - 1) < 0.05
     if name == "crack":
         assert abs(fit.parameters["depth_ratio"] / 0.4 - 1) < 0.1
+
+
+def test_changed_rows_read_in_place_are_the_sparse_differences():
+    """Where a point's matrix has the first point's pattern its changed rows are read from
+    the entries in place; they are the rows of the sparse difference's entries above the
+    threshold, in the same order (and a matrix of another pattern takes the difference)."""
+    import scipy.sparse as sp
+
+    rng = np.random.default_rng(7)
+    A0 = sp.random(40, 40, density=0.2, random_state=rng, format="csr") + sp.eye(40)
+    A0 = sp.csr_matrix(A0 + A0.T)
+    rows_kept = {}
+    for _ in range(20):
+        A = A0.copy()
+        touched = rng.choice(A.nnz, size=int(rng.integers(0, 12)), replace=False)
+        A.data[touched] += rng.choice([1e-14, 1e-3, -2.0], size=touched.size)
+        tiny = 1e-12 * abs(A0).max()
+        D = sp.coo_matrix(A - A0)
+        expected = D.row[np.abs(D.data) > tiny]
+        got = screening._changed_rows(A, A0, tiny, rows_kept)
+        assert np.array_equal(got, expected)
+        row = np.repeat(np.arange(40), np.diff(A0.indptr))
+        big = touched[np.abs(A.data[touched] - A0.data[touched]) > tiny]
+        assert sorted(got) == sorted(row[big])   # the entries changed beyond rounding
+    assert len(rows_kept) == 1   # one pattern, its rows computed once
+    other = sp.csr_matrix(A0 + sp.csr_matrix(([5.0], ([3], [17])), shape=(40, 40)))
+    if other.nnz == A0.nnz:   # (the entry was already there: make a new one)
+        other = sp.csr_matrix(A0 + sp.csr_matrix(([5.0], ([0], [39])), shape=(40, 40)))
+    D = sp.coo_matrix(other - A0)
+    assert np.array_equal(screening._changed_rows(other, A0, 0.0, {}), D.row[D.data != 0])
