@@ -326,6 +326,18 @@ class Diagnosis:
         return caveats_of(self.notes)
 
     @property
+    def drawn_alternatives(self) -> list[Effect]:
+        """The effects a figure draws hollow where the finding fits as well: the
+        alternatives of the caveats on its place (``mirror``, ``places``) and of those on
+        its kind (``alike``: not with a pair suggested, whose note compares the effects
+        alone); not those on an effect the model holds already, which the figures do not
+        draw."""
+        kinds = ("mirror", "places") if self.together is not None else \
+            ("mirror", "places", "alike")
+        return [e for c in self.caveats if c.kind in kinds and c.present is None
+                for effects in c.alternatives for e in effects]
+
+    @property
     def current(self) -> Misfit:
         """The misfit of the model as it stands (present effects re-estimated)."""
         return self.reference.misfit if self.reference else self.baseline

@@ -588,10 +588,8 @@ def frame_diagnosis_figures(diagnosis, model: FrameModel, title: str, found) -> 
         failing.append((tuple(point[0]), sensor_label(sensor)))
     # what the data do not decide about the finding (the diagnosis's caveats, in their own
     # words) and where else its effect fits as well (their alternatives, drawn hollow)
-    from .report import drawn_alternatives
-
     caveats = diagnosis.caveats
-    elsewhere = [_mark(model, e.name, e.parameters) for e in drawn_alternatives(diagnosis)
+    elsewhere = [_mark(model, e.name, e.parameters) for e in diagnosis.drawn_alternatives
                  if "member" in e.parameters or "node" in e.parameters]
     return {"frame_diagnosis.png": plots.frame_findings(members, marks, failing, title,
                                                         [str(c) for c in caveats],

@@ -39,22 +39,12 @@ def findings(diagnosis, model) -> list:
             for i, (e, s) in enumerate(zip(fit.effects, fit.sigma)) if i >= held]
 
 
-def drawn_alternatives(diagnosis) -> list:
-    """The effects a figure draws hollow where the finding fits as well: the alternatives
-    of the caveats on its place (``mirror``, ``places``) and of those on its kind
-    (``alike``: not with a pair suggested, whose note compares the effects alone); not
-    those on an effect the model holds already, which the figures do not draw."""
-    kinds = ("mirror", "places") if diagnosis.together is not None else \
-        ("mirror", "places", "alike")
-    return [e for c in diagnosis.caveats if c.kind in kinds and c.present is None
-            for effects in c.alternatives for e in effects]
-
-
 def elsewhere(diagnosis) -> list:
     """Where on a beam or bar an effect fits as well as the one found (its mirror place,
-    another effect's place: :func:`drawn_alternatives`), as (x, effect name)."""
+    another effect's place: :attr:`~gfe_opt.diagnosis.Diagnosis.drawn_alternatives`), as
+    (x, effect name)."""
     out = []
-    for e in drawn_alternatives(diagnosis):
+    for e in diagnosis.drawn_alternatives:
         x = effect_type(e.name).position(e.parameters)
         if isinstance(x, (int, float)):
             out.append((float(x), e.name))

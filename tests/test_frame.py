@@ -1387,8 +1387,11 @@ def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
                                        "depth_ratio": 0.3})]], present=0),
              "a plain note: the frequencies cannot tell these places apart",
              "no mode shapes: modes paired by frequency"]
-    stand_in = SimpleNamespace(notes=notes, localisation=[], together=None)
-    stand_in.caveats = Diagnosis.caveats.fget(stand_in)
+    class StandIn(SimpleNamespace):   # a diagnosis of these notes, as the figure reads it
+        caveats = Diagnosis.caveats
+        drawn_alternatives = Diagnosis.drawn_alternatives
+
+    stand_in = StandIn(notes=notes, localisation=[], together=None)
     portal = portal_frame()
     frame_diagnosis_figures(stand_in, portal, "title", [])
     assert said["caveats"] == [str(n) for n in notes[1:6]]

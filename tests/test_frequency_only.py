@@ -122,8 +122,7 @@ def test_a_cracks_mirror_image_is_named_not_guessed(start):
                      freq_noise=0.0003)
     present, = [c for c in later.caveats if c.kind == "mirror"]
     assert present.startswith("the present crack (effects[0]) at x = ") and present.present == 0
-    from gfe_opt.report import drawn_alternatives
-    assert drawn_alternatives(later) == []   # the figures draw the finding's, not these
+    assert later.drawn_alternatives == []   # the figures draw the finding's, not these
     assert present.alternatives[0][0].parameters["position"] == pytest.approx(L - x, abs=1e-3)
 
 
