@@ -112,8 +112,9 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
             Ks, Ms = _restricted(Kf, free, d), _restricted(Mf, free, d)
             lu = spla.splu((Ks - sigma * Ms).tocsc())
             start = np.random.default_rng(0).standard_normal(Ks.shape[0])  # deterministic
-            lam, vec = spla.eigsh(Ks, k=n_modes, M=_Direct(_product(Ms)), sigma=sigma,
-                                  which="LM", OPinv=_Direct(lu.solve, Ks.shape[0]), tol=1e-12,
+            size = Ks.shape[0]
+            lam, vec = spla.eigsh(Ks, k=n_modes, M=_Direct(_product(Ms), size), sigma=sigma,
+                                  which="LM", OPinv=_Direct(lu.solve, size), tol=1e-12,
                                   v0=start)
     except (RuntimeError, spla.ArpackError, np.linalg.LinAlgError) as exc:
         raise GfeSolverError(f"eigen solve failed: {exc}") from exc
@@ -139,9 +140,7 @@ class _Direct(spla.LinearOperator):
     solve 5.1 → 4.3 ms).  The same kernels as before are called on the same vectors: the
     same numbers."""
 
-    def __init__(self, fn, n: int | None = None):
-        if n is None:
-            fn, n = fn
+    def __init__(self, fn, n: int):
         super().__init__(float, (n, n))
         self._fn = fn
 
@@ -153,8 +152,8 @@ class _Direct(spla.LinearOperator):
 
 
 def _product(A):
-    """(x ↦ A x, n) for a square CSC matrix ``A``: the kernel ``A @ x`` reaches
-    (``csc_matvec``), called directly; ``A @ x`` itself where scipy has no such kernel."""
+    """x ↦ A x for a square CSC matrix ``A``: the kernel ``A @ x`` reaches (``csc_matvec``),
+    called directly; ``A @ x`` itself where scipy has no such kernel."""
     n = A.shape[0]
 
     def plain(x):
@@ -162,7 +161,7 @@ def _product(A):
     try:
         from scipy.sparse._sparsetools import csc_matvec
     except ImportError:   # (a private module of scipy: used only where it exists)
-        return plain, n
+        return plain
     indptr, indices, data = A.indptr, A.indices, A.data
 
     def product(x):
@@ -176,7 +175,7 @@ def _product(A):
         same = np.array_equal(product(probe), plain(probe))
     except (TypeError, ValueError, RuntimeError):
         same = False
-    return (product if same else plain), n
+    return product if same else plain
 
 
 def rigid_as_zero(lam, eigenvalue_scale: float, roundoff_fraction: float = 1e-8):

@@ -146,8 +146,8 @@ def test_changed_rows_read_in_place_are_the_sparse_differences():
         big = touched[np.abs(A.data[touched] - A0.data[touched]) > tiny]
         assert sorted(got) == sorted(row[big])   # the entries changed beyond rounding
     assert len(rows_kept) == 1   # one pattern, its rows computed once
-    other = sp.csr_matrix(A0 + sp.csr_matrix(([5.0], ([3], [17])), shape=(40, 40)))
-    if other.nnz == A0.nnz:   # (the entry was already there: make a new one)
-        other = sp.csr_matrix(A0 + sp.csr_matrix(([5.0], ([0], [39])), shape=(40, 40)))
+    i, j = np.argwhere(A0.toarray() == 0)[0]   # an entry outside the pattern
+    other = sp.csr_matrix(A0 + sp.csr_matrix(([5.0], ([i], [j])), shape=(40, 40)))
+    assert other.nnz == A0.nnz + 1   # another pattern: the sparse difference is taken
     D = sp.coo_matrix(other - A0)
     assert np.array_equal(screening._changed_rows(other, A0, 0.0, {}), D.row[D.data != 0])
