@@ -2012,7 +2012,9 @@ class Followed:
     """Result of :func:`follow`: the final model, the fit of its effects (None when
     nothing was added or taken out), the last diagnosis, and what the loop did: the verdict
     of each diagnosis in order, the effects added (``add`` arguments, in order), those
-    taken out (``dropped``) and a not-needed one kept because consistency needs it."""
+    taken out (``dropped``) and a not-needed one kept because consistency needs it;
+    ``caveats``: those of every diagnosis that led to the final model, in order (what a user
+    following the loop was told the data leave open)."""
 
     model: Model
     fit: Fit | None
@@ -2024,6 +2026,7 @@ class Followed:
     kept: str | None = None
     #: per effect of ``model``: whether the loop added it
     added_flags: list = field(default_factory=list)
+    caveats: list = field(default_factory=list)
 
     @property
     def found(self) -> list:
@@ -2044,7 +2047,8 @@ def follow(model: Model, measured: MeasuredModes, first: Diagnosis | None = None
     noise = {"freq_noise": freq_noise, "shape_noise": shape_noise}
     result = diagnose(model, measured, **noise) if first is None else first
     out = Followed(model=model, fit=None, diagnosis=result, first=result,
-                   verdicts=[result.verdict], added_flags=[False] * len(model.effects))
+                   verdicts=[result.verdict], added_flags=[False] * len(model.effects),
+                   caveats=list(result.caveats))
     adds = 0
     seen = {_loop_state(model)}
     while True:
@@ -2075,6 +2079,7 @@ def follow(model: Model, measured: MeasuredModes, first: Diagnosis | None = None
         out.added_flags = flags + [True] * (len(out.model.effects) - len(flags))
         out.added += add
         out.verdicts.append(result.verdict)
+        out.caveats += result.caveats
     return out
 
 

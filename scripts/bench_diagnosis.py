@@ -30,7 +30,14 @@ A case is scored:
   or ``unexplained`` (the model error of the family left over is a real difference);
 * position error (% of length) and size error of the effect matched to each hidden one
   (cracks by their rotational compliance ∫(1/EI − 1/EI₀)dx, whatever the law), and
-  |error|/σ of each fitted parameter whose truth is a parameter of the package.
+  |error|/σ of each fitted parameter whose truth is a parameter of the package;
+* a case not right is **said** when every hidden effect it misses is among the
+  alternatives of a caveat of a diagnosis in the loop (the JSON's ``caveats``: another
+  effect that fits as well, ``alike``; the finding at another place, ``mirror``,
+  ``places``, or with other parameters, ``equivalent``): the tool named the truth as what
+  the data cannot tell from its finding. A case neither right nor said whose last verdict
+  claims something (``consistent`` or ``effect_found``) is **confidently wrong**, the worst
+  thing the tool can print; ``unexplained`` is not.
 
 Prints one JSON document (``--json`` writes it to a file too) and a table per class.
 """
@@ -60,6 +67,9 @@ from tests import truths  # noqa: E402
 
 POSITION_TOLERANCE = 0.02   # of the length (issue 21)
 OUT_OF_FAMILY_VERDICTS = {"consistent", "unexplained"}
+#: caveats that name what fits as well as the finding (a case missing a truth they name
+#: is scored "said", not confidently wrong)
+SAID_KINDS = ("alike", "mirror", "places", "equivalent")
 
 
 def crack_compliance(effect, model) -> float | None:
@@ -193,6 +203,7 @@ def follow(model, measured, noise, result, row):
         row.setdefault("dropped", []).extend(done.dropped)
     if done.kept is not None:
         row["kept"] = done.kept
+    row["caveats"] = [c.to_json() for c in done.caveats]
     return done.model, done.fit, done.diagnosis
 
 
@@ -317,8 +328,11 @@ def _score(row, case, model, fit, added=None):
             for k in over:
                 positions.append(100 * _outside(case.hidden[k].position, e, model))
                 del missing[k]
+    required = []
     for k, best in missing.items():
         right = right and best is None and not shown[k]   # unseen: not required
+        if not (best is None and not shown[k]):
+            required.append(case.hidden[k])
         if best is not None and case.hidden[k].position is not None:
             positions.append(100 * best[1])
     for i, hids in covered.items():
@@ -351,6 +365,9 @@ def _score(row, case, model, fit, added=None):
         right = True   # the data cannot show it: "consistent" with nothing added is right
     if rescoring and not all("uncertainty" in e for e in row.get("final_effects", [])):
         z = row.get("z", [])   # rows stored without the σ of their fit
+    said = _said(required, row.get("caveats"), model) if not right and required else None
+    row.update(said=said, confident_wrong=not right and said is None
+               and final in ("consistent", "effect_found"))
     row.update(class_right=right, verdict_right=right and verdict_ok,
                false_alarm=_no_local(case) and bool(extra_local),
                position_error_pct=positions, size_error_pct=sizes, z=z,
@@ -361,6 +378,29 @@ def _score(row, case, model, fit, added=None):
                                                       else {}).items()
                                     if not isinstance(v, list)}}
                    for i, e in enumerate(added)])
+
+
+def _said(missed, caveats, model) -> str | None:
+    """How the loop's caveats (``caveats``: their JSON) named every hidden effect in
+    ``missed`` as fitting as well as what it found: ``"alike"`` (another effect) when
+    every one was named by that kind alone, ``"place"`` (a mirror place, other places or
+    parameters) otherwise; None when one of them was named by none (or the row has no
+    caveats recorded)."""
+    if caveats is None:
+        return None
+    kinds = set()
+    for hid in missed:
+        names = truths.ANSWERS[hid.klass]
+        placed = hid.position is not None and hid.klass not in ("clamp", "pin_gives")
+        found = {c["kind"] for c in caveats if c["kind"] in SAID_KINDS
+                 for effects in c["alternatives"] for e in effects
+                 if e["effect"] in names and (not placed or abs(
+                     e["parameters"].get("position", np.inf) - hid.position)
+                     <= POSITION_TOLERANCE * model.length)}
+        if not found:
+            return None
+        kinds |= found
+    return "alike" if kinds == {"alike"} else "place"
 
 
 def scorecard(rows) -> dict:
@@ -378,6 +418,8 @@ def scorecard(rows) -> dict:
                 "verdict_right_pct": 100 * np.mean([r["verdict_right"] for r in rs]),
                 "class_right_pct": 100 * np.mean([r["class_right"] for r in rs]),
                 "false_alarms": int(sum(r["false_alarm"] for r in rs)),
+                "wrong_said": int(sum(r.get("said") is not None for r in rs)),
+                "confidently_wrong": int(sum(r.get("confident_wrong", False) for r in rs)),
                 "position_within_2pct": (100 * np.mean([p <= 100 * POSITION_TOLERANCE
                                                         for p in pos]) if pos else None),
                 "position_error_pct_median": float(np.median(pos)) if pos else None,
@@ -440,7 +482,8 @@ def targets(rows) -> list:
 
 def table(card) -> str:
     head = (f"{'class':<12}{'cases':>6}{'verdict':>9}{'class':>7}{'false':>7}{'pos<2%':>8}"
-            f"{'pos med':>9}{'size med':>10}{'|z|<=2':>8}{'exit2':>7}{'errors':>7}{'s/case':>8}")
+            f"{'pos med':>9}{'size med':>10}{'|z|<=2':>8}{'said':>6}{'conf.':>6}{'exit2':>7}"
+            f"{'errors':>7}{'s/case':>8}")
     lines = [head, "-" * len(head)]
 
     def f(v, fmt):
@@ -451,7 +494,8 @@ def table(card) -> str:
                      f"{f(s['position_within_2pct'], '.0f'):>7}%"
                      f"{f(s['position_error_pct_median'], '.2f'):>9}"
                      f"{f(s['size_error_pct_median'], '.1f'):>9}%"
-                     f"{f(s['z_le_2_pct'], '.0f'):>7}%{s['exit_2']:>7}"
+                     f"{f(s['z_le_2_pct'], '.0f'):>7}%{s['wrong_said']:>6}"
+                     f"{s['confidently_wrong']:>6}{s['exit_2']:>7}"
                      f"{s['internal_errors']:>7}{s['seconds_per_case']:>8.1f}")
     return "\n".join(lines)
 
