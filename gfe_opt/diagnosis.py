@@ -1428,7 +1428,8 @@ def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[st
     places = _other_places(best, measured, noise, C, sel, together)
     if places is not None:
         notes.append(places)
-    notes += equivalent_notes(best, measured)
+    told = [alt for c in (mirror, places) if c is not None for alt in c.alternatives]
+    notes += equivalent_notes(best, measured, told)
     return notes
 
 
@@ -1604,13 +1605,34 @@ def _undecided_note(fit, undecided, measured, held,
                   [effects[held:] for effects in undecided])
 
 
-def equivalent_notes(fit, measured) -> list[Caveat]:
-    """Sentences for other parameter sets that fit the data as well as ``fit``."""
+def equivalent_notes(fit, measured, told=()) -> list[Caveat]:
+    """Sentences for other parameter sets that fit the data as well as ``fit``, but those
+    that are its added effect at a place another caveat names already (``told``: their
+    alternatives, the added effect moved there; a beam's mirror image, which a fit from
+    every valley of its grid also ends at)."""
     what = "the frequencies" if measured.frequency_only else "the data"
     return [Caveat(f"{what} fit as well with " + "; ".join(
         f"{e.name}: {effect_type(e.name).describe(e.parameters)}" for e in effects)
         + f" — {what} cannot tell these apart", "equivalent", [effects])
-        for effects in fit.equivalent]
+        for effects in fit.equivalent if not _told(effects, fit, told)]
+
+
+def _told(effects, fit, told) -> bool:
+    """Whether the effect list ``effects`` is ``fit``'s with its added effect replaced by
+    the one alternative of ``told`` (positions within 2 % of a beam's length, other numbers
+    within 5 %: :func:`_mirrored`'s tolerances); a frame's places are not compared."""
+    i = fit.added
+    if i is None or structure(fit.model).discrete_places or len(effects) != len(fit.effects):
+        return False
+    length = fit.model.length
+
+    def same(a, b):   # _mirrored's tolerances, the place not mirrored
+        x = b.parameters.get("position")
+        return _mirrored((a,), (b if not isinstance(x, (int, float))
+                                else _moved(b, length - x),), length)
+
+    return all(same(a, b) for j, (a, b) in enumerate(zip(effects, fit.effects)) if j != i) \
+        and any(len(alt) == 1 and same(effects[i], alt[0]) for alt in told)
 
 
 def _mirror(fit, measured, noise, C, sel, index=None) -> Caveat | None:

@@ -655,8 +655,14 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     def bulk(zs, null):   # grids screened in bulk (:mod:`.screening`)
         return screened_chi2(residual, chi2, zs, null) if SCREEN else None
 
-    for grid in variants:
-        start, guess = _grid_start(chi2, grid, nulls, bulk)
+    # each added effect's place variable (a valley of the grid along it may hold the
+    # optimum that the grid's coarse sizes ranked second: frequencies alone)
+    places = [next((k for k, v in enumerate(slot.variables) if v.key == "position"), None)
+              for slot in slots]
+    valleys = []
+    for n, grid in enumerate(variants):
+        start, guess = _grid_start(chi2, grid, nulls, bulk, places=places,
+                                   valleys=valleys if n == 0 else None)
         starts.append(np.clip(start, lower, upper))
         if guess is not None:
             informed.append(problem.untied(np.clip(guess, lower, upper)))
@@ -688,8 +694,19 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
             # effect, a few Gauss-Newton steps move the others first; the fit runs from the
             # best of those and from every start
             more = [s for s in starts if s is not first] if multistart is True else []
-            more += _profile_starts(residual, chi2, first, grids, slots, lower, upper,
-                                    nulls[-1] if nulls else None)
+            profiled = _profile_starts(residual, chi2, first, grids, slots, lower, upper,
+                                       nulls[-1] if nulls else None)
+            more += profiled
+            if not profiled:
+                # one effect (no other to profile over): from the best grid point of every
+                # other valley along its place.  Six frequencies give a crack a valley every
+                # few tenths of the length, and the grid's coarse depths can rank the one
+                # holding the optimum (χ² 8.6) below another (2 887): a confident wrong
+                # answer when another effect fits better than the wrong valley
+                for v in valleys:
+                    v = problem.untied(np.clip(v, lower, upper))
+                    if not any(np.array_equal(v, s) for s in (first, *more)):
+                        more.append(v)
             ends += [_minimise(residual, chi2, z0, lower, upper, max_iter) for z0 in more]
         # each end as its effects lie on the structure (a zone fitted past an end: the part
         # on it), so that ends that are one structure compare equal
@@ -1301,6 +1318,28 @@ def _with_null(effect: EffectType, v, base) -> tuple:
     return v.grid if any(abs(z - g) < 1e-12 for g in v.grid) else (z, *v.grid)
 
 
+def _valleys(points: np.ndarray, values, null, k: int) -> list[int]:
+    """The grid points that are each the best of a valley of the grid's profile along
+    variable ``k`` (a place): at each value of it the lowest point where the effect is
+    present (``null``: vanished points, which have no place), and of those the ones lower
+    than the place before and no higher than the one after (a plateau's first; values
+    within :data:`TIE` count as equal, so rounding does not move a valley)."""
+    places = np.unique(points[:, k])
+    profile, best = [], []
+    for x in places:
+        at = [j for j in np.flatnonzero(points[:, k] == x)
+              if not null[j] and np.isfinite(values[j])]
+        best.append(at[lowest([values[j] for j in at])] if at else None)
+        profile.append(values[best[-1]] if at else np.inf)
+
+    def below(a, b):   # a lower than b beyond a tie
+        return np.isfinite(a) and a < b - TIE * max(abs(a), 1.0)
+
+    return [best[m] for m in range(len(places)) if best[m] is not None
+            and (m == 0 or below(profile[m], profile[m - 1]))
+            and (m + 1 == len(places) or not below(profile[m + 1], profile[m]))]
+
+
 def _null_points(points: np.ndarray, nulls) -> np.ndarray:
     """Which grid points are the effect vanished: every sizing variable at its exact null
     value (:func:`_null_of` with ``exact``; one that only comes close, NaN: no point).
@@ -1324,13 +1363,16 @@ def _value(start: dict, v) -> float:
     return start[v.key] if v.index is None else start[v.key][v.index]
 
 
-def _grid_start(chi2, grids, nulls=None, bulk=None):
+def _grid_start(chi2, grids, nulls=None, bulk=None, places=None, valleys=None):
     """Best point of a coarse grid: each slot's grid (the product of its variables' grids)
     searched with the other slots at their current point.  Of the points where a slot's
     effect vanishes (``nulls``: per slot, per variable, :func:`_null_of`) only the first is
     evaluated: they are one structure.  Returns the start and, when a vanished effect with a
     place won the last searched slot, the best point where it does not (else None): the
-    grid's own guess of its place, which a vanished start cannot give."""
+    grid's own guess of its place, which a vanished start cannot give.  With ``places``
+    (per slot, the index of its place variable or None) and a list ``valleys``, the last
+    slot's valleys along its place (:func:`_valleys`) are appended to it as full points
+    (the best one's included)."""
     current = [np.array([g[0] for g in slot], dtype=float) for slot in grids]
     if not current:
         return np.zeros(0), None
@@ -1354,6 +1396,11 @@ def _grid_start(chi2, grids, nulls=None, bulk=None):
         for j, value in zip(solved, found):
             values[j] = value
         best = lowest(values)
+        if valleys is not None and i == len(grids) - 1 and places and places[i] is not None:
+            for j in _valleys(points, values, null, places[i]):
+                trial = list(current)
+                trial[i] = points[j]
+                valleys.append(np.concatenate(trial))
         current[i] = points[best]
         informed = None
         placed = any(z is None for z in (nulls[i] if nulls else ()))  # a place, a length

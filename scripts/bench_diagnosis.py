@@ -35,7 +35,8 @@ A case is scored:
   alternatives of a caveat of a diagnosis in the loop (the JSON's ``caveats``: another
   effect that fits as well, ``alike``; the finding at another place, ``mirror``,
   ``places``, or with other parameters, ``equivalent``): the tool named the truth as what
-  the data cannot tell from its finding. A case neither right nor said whose last verdict
+  the data cannot tell from its finding; or the effect was found beyond the tolerance but
+  within twice the σ the tool gave its position. A case neither right nor said whose last verdict
   claims something (``consistent`` or ``effect_found``) is **confidently wrong**, the worst
   thing the tool can print; ``unexplained`` is not.
 
@@ -332,7 +333,7 @@ def _score(row, case, model, fit, added=None):
     for k, best in missing.items():
         right = right and best is None and not shown[k]   # unseen: not required
         if not (best is None and not shown[k]):
-            required.append(case.hidden[k])
+            required.append((case.hidden[k], best))
         if best is not None and case.hidden[k].position is not None:
             positions.append(100 * best[1])
     for i, hids in covered.items():
@@ -365,7 +366,8 @@ def _score(row, case, model, fit, added=None):
         right = True   # the data cannot show it: "consistent" with nothing added is right
     if rescoring and not all("uncertainty" in e for e in row.get("final_effects", [])):
         z = row.get("z", [])   # rows stored without the σ of their fit
-    said = _said(required, row.get("caveats"), model) if not right and required else None
+    said = _said(required, row.get("caveats"), model, added, sigmas) \
+        if not right and required else None
     row.update(said=said, confident_wrong=not right and said is None
                and final in ("consistent", "effect_found"))
     row.update(class_right=right, verdict_right=right and verdict_ok,
@@ -380,18 +382,28 @@ def _score(row, case, model, fit, added=None):
                    for i, e in enumerate(added)])
 
 
-def _said(missed, caveats, model) -> str | None:
-    """How the loop's caveats (``caveats``: their JSON) named every hidden effect in
-    ``missed`` as fitting as well as what it found: ``"alike"`` (another effect) when
-    every one was named by that kind alone, ``"place"`` (a mirror place, other places or
-    parameters) otherwise; None when one of them was named by none (or the row has no
-    caveats recorded)."""
+def _said(missed, caveats, model, added, sigmas) -> str | None:
+    """How the loop named every hidden effect in ``missed`` (pairs of the hidden effect and
+    the nearest added effect of a right name, its index and position error, or None): by
+    the caveats (``caveats``: their JSON) as fitting as well as what it found, ``"alike"``
+    (another effect) when every one was named by that kind alone, ``"place"`` (a mirror
+    place, other places or parameters) otherwise; or found beyond the tolerance but within
+    twice the σ it gave its position, ``"uncertainty"`` when that holds for every one; None
+    when one of them was named by none (or the row has no caveats recorded)."""
     if caveats is None:
         return None
     kinds = set()
-    for hid in missed:
+    for hid, nearest in missed:
         names = truths.ANSWERS[hid.klass]
         placed = hid.position is not None and hid.klass not in ("clamp", "pin_gives")
+        if placed and nearest is not None:
+            i, _ = nearest
+            sigma = (sigmas[i] if i < len(sigmas) else {}).get("position")
+            x = added[i].parameters.get("position")
+            if sigma is not None and x is not None and np.isfinite(sigma) \
+                    and abs(x - hid.position) <= 2.0 * sigma:
+                kinds.add("uncertainty")
+                continue
         found = {c["kind"] for c in caveats if c["kind"] in SAID_KINDS
                  for effects in c["alternatives"] for e in effects
                  if e["effect"] in names and (not placed or abs(
@@ -400,7 +412,7 @@ def _said(missed, caveats, model) -> str | None:
         if not found:
             return None
         kinds |= found
-    return "alike" if kinds == {"alike"} else "place"
+    return next(iter(kinds)) if kinds in ({"alike"}, {"uncertainty"}) else "place"
 
 
 def scorecard(rows) -> dict:

@@ -10,7 +10,15 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from gfe_opt.fitting import FINISH_DECREMENT, TIE, _finish, _grid_start, lowest, ranked
+from gfe_opt.fitting import (
+    FINISH_DECREMENT,
+    TIE,
+    _finish,
+    _grid_start,
+    _valleys,
+    lowest,
+    ranked,
+)
 from gfe_opt.modal import peak_rows
 
 T = np.linspace(0.0, 1.0, 12)
@@ -116,6 +124,47 @@ def test_a_vanished_effect_s_grid_points_are_one_start_whatever_rounding_says(va
         assert start == (0.05, 0.0) and informed == pytest.approx((0.7, 0.5))
     else:
         assert start == pytest.approx((0.7, 0.5)) and informed is None
+
+
+def test_a_grids_valleys_along_a_place_are_each_ones_best_point():
+    """Along the place (shuffled, ends appended as the place variables append them), the
+    profile over the sizes (vanished points excluded, whatever their value) has its local
+    minima at 0.2 and 0.6 (a plateau: its first place, whichever of the two is lower by
+    rounding) and at the end 1.0; each valley's point is its best size."""
+    profile = {0.0: 5.0, 0.2: 2.0, 0.4: 4.0, 0.6: 1.0, 0.8: 1.0, 1.0: 0.5}
+    rng = np.random.default_rng(0)
+    for wobble in (1e-12, -1e-12):
+        points, values = [], []
+        for x in (0.2, 0.4, 0.6, 0.8, 0.0, 1.0):
+            for size, extra in ((0.1, 3.0), (0.5, 0.0), (0.9, 7.0)):
+                points.append((x, size))
+                values.append(profile[x] + extra + (wobble if x == 0.8 else 0.0))
+        points.append((0.3, 0.0))       # the effect vanished: lowest of all, no place
+        values.append(-1.0)
+        null = np.array([p[1] == 0.0 for p in points])
+        order = rng.permutation(len(points))
+        points, values, null = np.array(points)[order], list(np.array(values)[order]), \
+            null[order]
+        found = sorted(tuple(points[j]) for j in _valleys(points, values, null, 0))
+        assert found == [(0.2, 0.5), (0.6, 0.5), (1.0, 0.5)]
+
+
+def test_grid_start_reports_the_last_slots_valleys():
+    """Two valleys of a place whose coarse sizes rank the shallower one first: both are
+    reported, the best point first in the grid's order of places."""
+    places, sizes = tuple(np.linspace(0.05, 0.95, 19)), (0.0, 0.2, 0.45, 0.7)
+
+    def chi2(z):
+        place, size = z
+        deep = 8.0 + 5e4 * (place - 0.63) ** 2 + 3e3 * (size - 0.37) ** 2 / 0.005
+        shallow = 2000.0 + 2e6 * (place - 0.46) ** 2 + 10.0 * (size - 0.45) ** 2
+        return min(deep, shallow) if size else 10000.0
+
+    valleys = []
+    start, _ = _grid_start(chi2, [[places, sizes]], [[None, 0.0]], places=[0],
+                           valleys=valleys)
+    assert start == pytest.approx((0.45, 0.45))
+    assert np.allclose(valleys, [(0.45, 0.45), (0.65, 0.45)], rtol=0, atol=1e-12)
 
 
 def test_mode_sign_follows_the_first_of_equal_peaks():
