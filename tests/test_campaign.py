@@ -63,8 +63,9 @@ def test_a_campaign_subset_meets_the_targets_relaxed_for_its_size():
     assert np.isfinite(card["seconds_per_case"])
 
 
-def _scored(hidden, added, marginal=(), verdict="consistent"):
-    """The campaign's score of a finished loop that added ``added`` [(name, parameters)]."""
+def _scored(hidden, added, marginal=(), verdict="consistent", caveats=None, sigma=None):
+    """The campaign's score of a finished loop that added ``added`` [(name, parameters)]
+    (``caveats``: the loop's, as JSON; ``sigma``: each added effect's σ)."""
     from types import SimpleNamespace
 
     sys.path.insert(0, str(ROOT / "scripts"))
@@ -77,9 +78,43 @@ def _scored(hidden, added, marginal=(), verdict="consistent"):
                 marginal=marginal)
     effects = [SimpleNamespace(name=n, parameters=p) for n, p in added]
     row = {"verdicts": [verdict], "final_effects": []}
-    bench_diagnosis._score(row, case, make_model(), SimpleNamespace(sigma=[{}] * len(effects)),
+    if caveats is not None:
+        row["caveats"] = caveats
+    sigma = [{}] * len(effects) if sigma is None else sigma
+    bench_diagnosis._score(row, case, make_model(), SimpleNamespace(sigma=sigma),
                            added=effects)
     return row
+
+
+def test_a_wrong_finding_is_said_when_a_caveat_names_the_truth_else_confidently_wrong():
+    """A crack found at the wrong place: "said" when a caveat of the loop names the truth's
+    place (its mirror image) or the truth's effect at its place (alike), or when the truth
+    lies within twice the σ the tool gave the place; otherwise, with a verdict that claims
+    something, confidently wrong; ``unexplained`` claims nothing."""
+    from .truths import Hidden
+
+    L = make_model().length
+    crack = [Hidden("crack", 0.2 * L, {"compliance": 6e-6})]
+    found = [("crack", {"position": 0.8 * L, "depth_ratio": 0.4})]
+
+    def caveat(kind, name, x):
+        return {"kind": kind, "note": "", "present": None, "alternatives": [[
+            {"effect": name, "parameters": {"position": x}}]]}
+
+    mirror = _scored(crack, found, caveats=[caveat("mirror", "crack", 0.2 * L)])
+    assert not mirror["verdict_right"] and mirror["said"] == "place"
+    assert not mirror["confident_wrong"]
+    elsewhere = _scored(crack, found, caveats=[caveat("mirror", "crack", 0.5 * L)])
+    assert elsewhere["said"] is None and elsewhere["confident_wrong"]
+    assert _scored(crack, found, caveats=[])["confident_wrong"]
+    assert not _scored(crack, found, caveats=[], verdict="unexplained")["confident_wrong"]
+    mass = [("point_mass", {"position": 0.2 * L, "mass": 0.05})]
+    alike = _scored(crack, mass, caveats=[caveat("alike", "crack", 0.21 * L)])
+    assert alike["said"] == "alike" and not alike["confident_wrong"]
+    near = [("crack", {"position": 0.23 * L, "depth_ratio": 0.4})]
+    assert _scored(crack, near, caveats=[], sigma=[{"position": 0.02 * L}])["said"] \
+        == "uncertainty"
+    assert _scored(crack, near, caveats=[], sigma=[{"position": 0.01 * L}])["confident_wrong"]
 
 
 def test_the_campaign_scores_one_zone_over_two_close_cracks_and_ignores_what_data_cannot_show():
