@@ -1504,10 +1504,31 @@ def _undetermined(fit, model) -> list:
     for effects in fit.equivalent:
         if symmetric and _mirrored(fit.effects, effects, model.length):
             continue
-        if model.kind == "frame" and _swapped(fit.effects, effects, model):
+        if model.kind == "frame" and (_swapped(fit.effects, effects, model)
+                                      or _frame_mirrored(fit, effects)):
             continue
         out.append(effects)
     return out
+
+
+def _frame_mirrored(fit, effects) -> bool:
+    """Whether ``effects`` is ``fit``'s with its added effect at its mirror place along a
+    member that is its own image on a symmetric frame, no other local effect present
+    (:func:`_frame_mirror`'s place, which its caveat names: a finding whose place is in
+    doubt, not an undetermined one; a fit from every valley of its grid ends there too)."""
+    from .frame_data import mirror_members
+
+    i, model = fit.added, fit.model
+    if i is None or len(effects) != len(fit.effects) or any(
+            "member" in e.parameters or "node" in e.parameters
+            for j, e in enumerate(fit.effects) if j != i):
+        return False
+    member = fit.effects[i].parameters.get("member")
+    images = mirror_members(model)
+    if member is None or images is None or images[member] != (member, True) \
+            or effects[i].parameters.get("member") != member:
+        return False
+    return _mirrored(effects, fit.effects, model.member_length(model.member(member)))
 
 
 def _swapped(effects, others, model) -> bool:
@@ -1619,17 +1640,20 @@ def equivalent_notes(fit, measured, told=()) -> list[Caveat]:
 
 def _told(effects, fit, told) -> bool:
     """Whether the effect list ``effects`` is ``fit``'s with its added effect replaced by
-    the one alternative of ``told`` (positions within 2 % of a beam's length, other numbers
-    within 5 %: :func:`_mirrored`'s tolerances); a frame's places are not compared."""
-    i = fit.added
-    if i is None or structure(fit.model).discrete_places or len(effects) != len(fit.effects):
+    the one alternative of ``told`` (positions within 2 % of the beam's or the member's
+    length, other numbers within 5 %: :func:`_mirrored`'s tolerances)."""
+    i, model = fit.added, fit.model
+    if i is None or len(effects) != len(fit.effects):
         return False
-    length = fit.model.length
+    frame = structure(model).discrete_places
 
     def same(a, b):   # _mirrored's tolerances, the place not mirrored
         x = b.parameters.get("position")
-        return _mirrored((a,), (b if not isinstance(x, (int, float))
-                                else _moved(b, length - x),), length)
+        if not isinstance(x, (int, float)):
+            return _mirrored((a,), (b,), 1.0)
+        length = model.member_length(model.member(b.parameters["member"])) if frame \
+            else model.length
+        return _mirrored((a,), (_moved(b, length - x),), length)
 
     return all(same(a, b) for j, (a, b) in enumerate(zip(effects, fit.effects)) if j != i) \
         and any(len(alt) == 1 and same(effects[i], alt[0]) for alt in told)

@@ -82,7 +82,11 @@ least needed first.  Scored as the beam campaign:
   apart (``wrong_place_said_ambiguous``), and so is one found as another effect with a
   caveat naming the truth among the effects the data cannot tell from it
   (``wrong_effect_said_alike``).  The caveats are read as ``diagnose --json`` gives them
-  (their kind and alternatives, matched as a finding is), not from the notes' words;
+  (their kind and alternatives, matched as a finding is), not from the notes' words (the
+  first diagnosis's caveats; the beam campaign reads the whole loop's);
+* a case neither right nor said whose last verdict claims something (``consistent`` or
+  ``effect_found``) is **confidently wrong** (``confident_wrong``, ``confidently_wrong`` in
+  the scorecard), as in the beam campaign;
 * two instances of one effect found (two joint springs) whose sizes the diagnosis said
   trade (a ``split`` caveat: the sum told, not how it splits) are sized by their sum
   against the truths' sum, what the data fix and the tool claims
@@ -466,6 +470,9 @@ def run_case(case: dict) -> dict:
             "first_chi2_per_residual": first_chi2, "undetectable": undetectable,
             "class_right": class_right, "verdict_right": class_right and last in ok_verdicts,
             "place_said_ambiguous": said_ambiguous, "effect_said_alike": said_alike,
+            # wrong, the truth not named, and a claim made (the beam campaign's measure)
+            "confident_wrong": not (class_right and last in ok_verdicts)
+            and not (said_ambiguous or said_alike) and last in ("consistent", "effect_found"),
             "place_notes": [str(c) for c in caveats if c.kind in ("mirror", "places")],
             "alike_notes": [str(c) for c in caveats if c.kind == "alike"],
             "sizes_scored_as_sum": as_sum,
@@ -484,6 +491,7 @@ def scorecard(rows) -> dict:
                 "wrong_place_said_ambiguous": sum(r.get("place_said_ambiguous", False)
                                                   for r in rs),
                 "wrong_effect_said_alike": sum(r.get("effect_said_alike", False) for r in rs),
+                "confidently_wrong": sum(r.get("confident_wrong", False) for r in rs),
                 "undetectable": sum(r["undetectable"] for r in rs),
                 "size_error_pct_median": float(np.median(sizes)) if sizes else None,
                 "size_within_10pct": (100 * np.mean([s <= 10 for s in sizes]) if sizes
