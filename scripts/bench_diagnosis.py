@@ -368,8 +368,9 @@ def _score(row, case, model, fit, added=None):
         z = row.get("z", [])   # rows stored without the σ of their fit
     said = _said(required, row.get("caveats"), model, added, sigmas) \
         if not right and required else None
-    row.update(said=said, confident_wrong=not right and said is None
-               and final in ("consistent", "effect_found"))
+    # a row stored without the loop's caveats (before stop 55) cannot tell: None
+    row.update(said=said, confident_wrong=None if "caveats" not in row else (
+        not right and said is None and final in ("consistent", "effect_found")))
     row.update(class_right=right, verdict_right=right and verdict_ok,
                false_alarm=_no_local(case) and bool(extra_local),
                position_error_pct=positions, size_error_pct=sizes, z=z,
@@ -431,7 +432,7 @@ def scorecard(rows) -> dict:
                 "class_right_pct": 100 * np.mean([r["class_right"] for r in rs]),
                 "false_alarms": int(sum(r["false_alarm"] for r in rs)),
                 "wrong_said": int(sum(r.get("said") is not None for r in rs)),
-                "confidently_wrong": int(sum(r.get("confident_wrong", False) for r in rs)),
+                "confidently_wrong": int(sum(bool(r.get("confident_wrong")) for r in rs)),
                 "position_within_2pct": (100 * np.mean([p <= 100 * POSITION_TOLERANCE
                                                         for p in pos]) if pos else None),
                 "position_error_pct_median": float(np.median(pos)) if pos else None,
