@@ -112,9 +112,10 @@ class Discretisation:
 
     def strain_energy(self, shapes, params=None) -> np.ndarray:
         """Twice the total strain energy :math:`φ^T K φ` of each column of ``shapes``."""
-        u = shapes[self.element_dofs()]
         energy = self.element_strain_energy(shapes, params).sum(axis=0)
-        energy = energy + np.sum(u * (self.extra_stiffness @ u), axis=(0, 1))
+        if np.any(self.extra_stiffness):   # (adding its zero would change no bit)
+            u = shapes[self.element_dofs()]
+            energy = energy + np.sum(u * (self.extra_stiffness @ u), axis=(0, 1))
         for dof, value in self.nodal_stiffness:
             energy = energy + value * shapes[dof] ** 2
         return energy

@@ -14,7 +14,7 @@ element by element from relative deformations (no cancellation):
   :data:`RESIDUAL_TOLERANCE` (the eigenvalue error is of its square).
 * **condensed** (longer beams): the elements are grouped into about √N super-elements whose
   interior DOFs are condensed statically (Guyan: :math:`T = [I; -K_{II}^{-1}K_{IB}]`, one
-  sparse factorisation of the block-diagonal :math:`K_{II}`); the reduced pencil
+  banded Cholesky factorisation of the block-diagonal :math:`K_{II}`); the reduced pencil
   :math:`(T^TKT, T^TMT)` is solved densely, the fine shapes :math:`Tφ_c` get one dynamic
   correction :math:`φ_I \mathrel{+}= K_{II}^{-1} λ_c (Mφ)_I`, and their Rayleigh quotients
   are the eigenvalues.  The reduced stiffness is summed from the element deformations of the
@@ -22,8 +22,8 @@ element by element from relative deformations (no cancellation):
   changes no quotient by more than :data:`CONDENSATION_TOLERANCE` (the error left is of its
   square); otherwise the groups are halved and the solve repeated.  Rounding still grows as
   N³, so meshes finer than :data:`MAX_BEAM_ELEMENTS` are refused.  Measured
-  (``tests/test_modal.py``, ``scripts/bench_eigen_accuracy.py``): closed forms within 6e-9
-  up to 30 000 elements.
+  (``tests/test_modal.py``, ``scripts/bench_eigen_accuracy.py``): closed forms within 1e-10
+  up to 30 000 elements (6e-9 with the sparse LU used before).
 
 Results are deterministic (dense solvers; a fixed start vector for shift-invert).
 """
@@ -31,6 +31,7 @@ Results are deterministic (dense solvers; a fixed start vector for shift-invert)
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import scipy.linalg as sla
@@ -52,8 +53,9 @@ RESIDUAL_TOLERANCE = 1e-3
 #: Largest change of a Rayleigh quotient by the dynamic correction of the condensed shapes.
 CONDENSATION_TOLERANCE = 1e-3
 #: The finest beam mesh whose modal solve is verified: simply supported, clamped and
-#: cantilever closed forms within 6e-9 at 30 000 elements (tests/test_modal.py); at
-#: 40 000 the cantilever's first frequencies are 2e-6 off (rounding grows as N³).
+#: cantilever closed forms within 6e-9 at 30 000 elements (tests/test_modal.py) when it was
+#: set, with a sparse LU of K_II (40 000: 2e-6 off; rounding grows as N³); 1e-11 with the
+#: banded Cholesky since (40 000: 3.5e-10).  Kept: it is a model file's limit.
 MAX_BEAM_ELEMENTS = MAX_ELEMENTS["beam"]
 
 
@@ -296,7 +298,6 @@ def _condensed_modes(disc: Discretisation, n_modes: int, params) -> Modes:
                             "verifies (the stiffness condition number grows as N⁴); a few "
                             "thousand elements resolve the first modes to 1e-9")
     K, M = disc.global_matrices(params)
-    K, M = K.tocsc(), M.tocsc()
     groups = condensation_groups(n, n_modes)
     while True:
         guyan, corrected = _reduce_and_solve(disc, K, M, n_modes, groups, params)
@@ -322,49 +323,37 @@ def _reduce_and_solve(disc, K, M, n_modes, groups, params):
     dynamic correction, both mass-normalised."""
     n, per = disc.n_elements, disc.dofs_per_node
     L = disc.element_length
-    coarse = np.unique(np.round(np.linspace(0, n, groups + 1)).astype(int))
-    boundary = (coarse[:, None] * per + np.arange(per)).ravel()
-    is_b = np.zeros(disc.n_dof, dtype=bool)
-    is_b[boundary] = True
-    interior = np.flatnonzero(~is_b)
-    # each interior DOF couples to the boundary DOFs of its own group only: `per` at each end
-    group_of_node = np.searchsorted(coarse, np.arange(n + 1), side="right") - 1
-    group = group_of_node[interior // per]
-    local = group[:, None] * per + np.arange(2 * per)[None, :]  # positions in `boundary`
-    K_II = K[interior][:, interior].tocsc()
-    K_IB = K[interior][:, boundary].tocsr()
-    rows = np.arange(interior.size)
-    rhs = np.stack([np.asarray(K_IB[rows, local[:, k]]).ravel() for k in range(2 * per)], 1)
-    lu = spla.splu(K_II)
+    plan = _plan(n, per, groups)
+    interior, boundary, local = plan.interior, plan.boundary, plan.local
+    diagonals = {k: K.diagonal(k) for k in range(-plan.width, plan.width + 1)}
+    rhs = np.zeros(local.shape)
+    for k, (at, source) in plan.coupling.items():
+        rhs.flat[at] = diagonals[k][source]
+    solve = _interior_solver(K, plan, diagonals)
     # basis values of every fine DOF in its group's 2·per local columns
     basis = np.zeros((disc.n_dof, 2 * per))
-    basis[interior] = -lu.solve(rhs)
-    element_group = group_of_node[np.arange(n)]
-    dofs = disc.element_dofs()  # (n, 2 per)
-    U = basis[dofs]  # (n, 2 per, 2 per), boundary rows fixed below
-    first = coarse[element_group] == np.arange(n)          # element starts its group
-    last = coarse[element_group + 1] == np.arange(n) + 1   # element ends its group
-    eye = np.eye(per)
+    basis[interior] = -solve(rhs)
+    U = basis[plan.dofs]  # (n, 2 per, 2 per), boundary rows fixed below
+    first, last, eye = plan.first, plan.last, np.eye(per)
     U[first, :per, :per], U[first, :per, per:] = eye, 0.0
     U[last, per:, per:], U[last, per:, :per] = eye, 0.0
     stiffness = _reduced_element_stiffness(disc, U, params, L)
-    blocks_k = np.zeros((len(coarse) - 1, 2 * per, 2 * per))
+    blocks_k = np.zeros((len(plan.coarse) - 1, 2 * per, 2 * per))
     blocks_m = np.zeros_like(blocks_k)
-    np.add.at(blocks_k, element_group, stiffness)
+    np.add.at(blocks_k, plan.element_group, stiffness)
     Ut = np.swapaxes(U, 1, 2)
-    np.add.at(blocks_m, element_group, Ut @ disc.mass @ U)
+    np.add.at(blocks_m, plan.element_group, Ut @ disc.mass @ U)
     size = boundary.size
     Kc, Mc = np.zeros((size, size)), np.zeros((size, size))
-    for g in range(len(coarse) - 1):
+    for g in range(len(plan.coarse) - 1):
         sl = slice(g * per, (g + 2) * per)
         Kc[sl, sl] += blocks_k[g]
         Mc[sl, sl] += blocks_m[g]
-    where = {int(b): i for i, b in enumerate(boundary)}
     for dof, value in disc.nodal_stiffness:
-        if dof in where:
-            Kc[where[dof], where[dof]] += value
-        else:
+        at = plan.position[dof]
+        if at < 0:
             raise GfeSolverError("a spring at an interior node cannot be condensed")
+        Kc[at, at] += value
     fixed = np.flatnonzero(np.isin(boundary, disc.constrained))
     # the reduced pencil's rigid-body eigenvalues carry its rounding (eps times its condition
     # number, ~1e-7 of the modes computed); the fine Rayleigh quotients decide afterwards
@@ -372,12 +361,10 @@ def _reduce_and_solve(disc, K, M, n_modes, groups, params):
                           roundoff_fraction=1e-5)
     lam_c = (2.0 * np.pi * reduced.frequencies_hz) ** 2
     T = sp.csr_matrix((np.concatenate([np.ones(size), basis[interior].ravel()]),
-                       (np.concatenate([boundary, np.repeat(interior, 2 * per)]),
-                        np.concatenate([np.arange(size), local.ravel()]))),
-                      shape=(disc.n_dof, size))
+                       (plan.t_rows, plan.t_cols)), shape=(disc.n_dof, size))
     guyan = T @ reduced.shapes
     corrected = guyan.copy()
-    corrected[interior] += lu.solve((M @ guyan)[interior] * lam_c)  # dynamic correction
+    corrected[interior] += solve((M @ guyan)[interior] * lam_c)  # dynamic correction
     out = []
     for shapes in (guyan, corrected):
         shapes[disc.constrained] = 0.0
@@ -386,16 +373,102 @@ def _reduce_and_solve(disc, K, M, n_modes, groups, params):
     return out
 
 
+@dataclass(frozen=True)
+class _Plan:
+    """What the condensed route's index arithmetic depends on (the mesh, DOFs a node and
+    the groups), worked out once (:func:`_plan`)."""
+
+    coarse: np.ndarray       # the group ends (node indices)
+    boundary: np.ndarray     # their DOFs, in order
+    position: np.ndarray     # a DOF's position in ``boundary``, −1 for an interior one
+    interior: np.ndarray     # the other DOFs, ascending
+    local: np.ndarray        # (interior, 2 per): positions in ``boundary`` of its group's
+    element_group: np.ndarray
+    dofs: np.ndarray         # (n, 2 per) each element's DOFs
+    first: np.ndarray        # element starts its group
+    last: np.ndarray         # element ends its group
+    width: int               # half-bandwidth of K (node-by-node DOFs: 2 per − 1)
+    band: dict               # k ≥ 0: (columns of K_II's k-th superdiagonal, rows in K)
+    coupling: dict           # k: (flat positions in (interior, 2 per), rows in K's k-th diagonal)
+    t_rows: np.ndarray       # the Guyan basis T's entries: rows, then columns
+    t_cols: np.ndarray
+
+
+@lru_cache(maxsize=16)
+def _plan(n: int, per: int, groups: int) -> _Plan:
+    """The condensed route's indices for ``n`` elements of ``per`` DOFs a node in
+    ``groups`` groups.  An element couples the DOFs of its two nodes only, so K's entries
+    lie within ``2 per − 1`` of its diagonal, and an interior DOF's couplings to its group's
+    boundary DOFs (and K_II's band) are read from K's diagonals."""
+    coarse = np.unique(np.round(np.linspace(0, n, groups + 1)).astype(int))
+    n_dof = per * (n + 1)
+    boundary = (coarse[:, None] * per + np.arange(per)).ravel()
+    is_b = np.zeros(n_dof, dtype=bool)
+    is_b[boundary] = True
+    interior = np.flatnonzero(~is_b)
+    # each interior DOF couples to the boundary DOFs of its own group only: `per` at each end
+    group_of_node = np.searchsorted(coarse, np.arange(n + 1), side="right") - 1
+    group = group_of_node[interior // per]
+    local = group[:, None] * per + np.arange(2 * per)[None, :]  # positions in `boundary`
+    element_group = group_of_node[np.arange(n)]
+    width = 2 * per - 1
+    band = {}
+    for k in range(width + 1):
+        i = np.arange(interior.size - k)
+        same = np.flatnonzero(interior[i + k] - interior[i] == k)  # else a boundary DOF between
+        band[k] = (same + k, interior[same])
+    offsets = boundary[local] - interior[:, None]
+    coupling = {}
+    for k in range(-width, width + 1):
+        at = np.flatnonzero(offsets == k)
+        if at.size:   # K[i, i + k] is the k-th diagonal's entry i (k ≥ 0), i + k (k < 0)
+            coupling[k] = (at, interior[at // local.shape[1]] + min(k, 0))
+    size = boundary.size
+    position = np.full(n_dof, -1)
+    position[boundary] = np.arange(size)
+    return _Plan(coarse=coarse, boundary=boundary, position=position, interior=interior,
+                 local=local,
+                 element_group=element_group,
+                 dofs=np.arange(n)[:, None] * per + np.arange(2 * per)[None, :],
+                 first=coarse[element_group] == np.arange(n),
+                 last=coarse[element_group + 1] == np.arange(n) + 1,
+                 width=width, band=band, coupling=coupling,
+                 t_rows=np.concatenate([boundary, np.repeat(interior, 2 * per)]),
+                 t_cols=np.concatenate([np.arange(size), local.ravel()]))
+
+
+def _interior_solver(K, plan: _Plan, diagonals: dict):
+    """x ↦ K_II⁻¹ x for the interior DOFs of the condensed route: a banded Cholesky factor
+    (LAPACK ``pbtrf``: the interior block is positive definite, its groups clamped at their
+    ends), else (a compression past a group's buckling load) the sparse LU of ``K_II``.
+    The sparse LU and its solves took a third of a condensed solve (2 000 elements)."""
+    width, interior = plan.width, plan.interior
+    ab = np.zeros((width + 1, interior.size))   # upper form: ab[width + i − j, j] = K_II[i, j]
+    for k, (columns, rows) in plan.band.items():
+        ab[width - k, columns] = diagonals[k][rows]
+    try:
+        factor = sla.cholesky_banded(ab, lower=False, check_finite=False)
+    except np.linalg.LinAlgError:
+        lu = spla.splu(sp.csc_matrix(K)[interior][:, interior].tocsc())
+        return lu.solve
+    return lambda x: sla.cho_solve_banded((factor, False), x, check_finite=False)
+
+
 def _reduced_element_stiffness(disc, U, params, L):
     """Σ over each element of Dᵀ P D / L³ (+ its extra stiffness Uᵀ K_x U): the element's
-    share of the reduced stiffness, D the deformations of the reduced basis ``U``."""
+    share of the reduced stiffness, D the deformations of the reduced basis ``U``
+    (:data:`~gfe_opt.elements.BEAM_DEFORMATION_H` written out: w₁ − w₂ + Lθ₂ and
+    L(θ₁ − θ₂); elementwise, where numpy's stacked 2 × 4 products cost ten times more)."""
     params = disc.stiffness_params if params is None else params
-    u = U * el.beam_dof_scaling(L)[None, :, None]
-    d = np.einsum("ij,ejk->eik", el.BEAM_DEFORMATION_H, u)  # (n, 2, 2 per)
-    P = np.stack([np.stack([params["k_ww"], params["k_wt"]], -1),
-                  np.stack([params["k_wt"], params["k_tt"]], -1)], -2)
-    out = np.swapaxes(d, 1, 2) @ P @ d / L**3
-    return out + np.swapaxes(U, 1, 2) @ disc.extra_stiffness @ U
+    d0 = U[:, 0] - U[:, 2] + L * U[:, 3]          # (n, 2 per)
+    d1 = L * U[:, 1] - L * U[:, 3]
+    ww, wt, tt = (params[k][:, None, None] for k in ("k_ww", "k_wt", "k_tt"))
+    cross = d0[:, :, None] * d1[:, None, :]
+    out = (ww * (d0[:, :, None] * d0[:, None, :]) + wt * (cross + np.swapaxes(cross, 1, 2))
+           + tt * (d1[:, :, None] * d1[:, None, :])) / L**3
+    if np.any(disc.extra_stiffness):
+        out = out + np.swapaxes(U, 1, 2) @ disc.extra_stiffness @ U
+    return out
 
 
 def rigid_body_count(disc) -> int:
