@@ -38,7 +38,6 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from . import elements as el
 from .assembly import Discretisation, discretise
 from .errors import GfeInputError, GfeSolverError
 from .inputs import MAX_ELEMENTS
