@@ -270,14 +270,33 @@ def observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
     """(n_sensors, n_dof): each sensor's reading of a displacement vector; built once a
     mesh (its nodes, elements and DOFs: a joint spring gives a member end its own rotation)
     and set of sensors, a copy returned."""
+    return _kept_reading(_OBSERVATIONS, model, mesh, sensors)
+
+
+#: readings of the places of point masses and springs (:func:`attached_reading`), kept
+#: apart from the sensors' so that a fit moving a mass does not push theirs out
+_ATTACHED: dict = {}
+
+
+def attached_reading(model: FrameModel, mesh: FrameMesh, places) -> sp.csr_matrix:
+    """:func:`observation` of the places where point masses or springs act (what
+    ``frame._attached`` reads them with), kept as the sensors' readings are: every fit of
+    another effect on a frame with a mass reads the mass's unchanged place again."""
+    return _kept_reading(_ATTACHED, model, mesh, places)
+
+
+def _kept_reading(kept: dict, model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_matrix:
+    """:func:`build_observation` of ``sensors`` through ``mesh`` from ``kept`` (least
+    recently used first out, at most :data:`OBSERVATIONS_KEPT`), then as the members
+    read it (:func:`with_shear`, a copy)."""
     key = _reading_key(model, mesh, sensors)
-    C = _OBSERVATIONS.pop(key, None)   # kept, it goes back in as the newest
+    C = kept.pop(key, None)   # kept, it goes back in as the newest
     if C is None:
         C = build_observation(model, mesh, sensors)
-        while _OBSERVATIONS and len(_OBSERVATIONS) >= OBSERVATIONS_KEPT:
-            _OBSERVATIONS.pop(next(iter(_OBSERVATIONS)))   # the least recently used
+        while kept and len(kept) >= OBSERVATIONS_KEPT:
+            kept.pop(next(iter(kept)))   # the least recently used
     if OBSERVATIONS_KEPT > 0:
-        _OBSERVATIONS[key] = C
+        kept[key] = C
     return with_shear(model, mesh, sensors, C)
 
 

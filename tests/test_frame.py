@@ -276,6 +276,48 @@ def test_kept_members_and_patterns_assemble_what_a_plain_sum_does():
     assert np.array_equal(Ke_first[~column], Ke[~column])
 
 
+def test_point_masses_and_springs_are_assembled_as_the_sparse_product_bit_for_bit(
+        monkeypatch):
+    """frame_matrices adds Cᵀ diag(v) C of the frame's point masses and springs from the
+    columns C reads (frame._outer_sum): the same K and M, entries and structure, as the
+    three sparse products it replaced, with three masses (two on one element: four rows
+    summed into the same entries), springs along x and y, and under shear (the Timoshenko
+    reading); and the kept reading of their places is the reading built anew."""
+    import scipy.sparse as sp
+
+    from gfe_opt import frame
+    from gfe_opt.frame_data import build_observation, with_shear
+
+    base = portal_frame(9)
+    masses = [("beam", 0.101, 0.05), ("beam", 0.104, 0.02), ("left-column", 0.3, 0.4)]
+    springs = [("beam", 0.2, "x", 3e4), ("right-column", 0.15, "y", 1e5),
+               ("beam", 0.33, "y", 7e3)]
+    effects = [Effect("point_mass", {"member": m, "position": x, "mass": v})
+               for m, x, v in masses]
+    effects += [Effect("point_spring", {"member": m, "position": x, "direction": d,
+                                        "stiffness": k}) for m, x, d, k in springs]
+    models = (base.with_effects(effects),
+              base.with_effects(effects + [Effect("shear", {"shear_rigidity": 2e6})]))
+    ours = [frame_matrices(model) for model in models]
+    for model in models:
+        mesh = frame_mesh(model)
+        for name, places in (("point_mass", [{"member": m, "position": x, "direction": d}
+                                             for m, x, _ in masses for d in ("x", "y")]),
+                             ("point_spring", [{"member": m, "position": x, "direction": d}
+                                               for m, x, d, _ in springs])):
+            C, values = frame._attached(model, mesh, name)
+            anew = with_shear(model, mesh, places, build_observation(model, mesh, places))
+            assert C.shape == anew.shape and (C != anew).nnz == 0
+    monkeypatch.setattr(frame, "_outer_sum",
+                        lambda C, v: (C.T @ sp.diags(v) @ C).tocsr())
+    for (K, M), model in zip(ours, models):
+        for a, b in zip((K, M), frame_matrices(model)):
+            assert np.array_equal(a.indptr, b.indptr)
+            assert np.array_equal(a.indices, b.indices)
+            assert np.array_equal(a.data, b.data)
+        assert not np.array_equal(M.toarray(), frame_matrices(base)[1].toarray())
+
+
 def test_a_one_member_frame_is_the_beam_with_its_crack():
     """A vertical column clamped at its base is the package's cantilever beam: the same
     bending frequencies with the same Christides–Barr crack (to 5e-9: the beam integrates
