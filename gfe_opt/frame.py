@@ -1106,7 +1106,7 @@ def _attached(model: FrameModel, mesh: FrameMesh, name: str):
     found = [e for e in model.raw_effects if e["effect"] == name]
     if not found:
         return None
-    from .frame_data import attached_reading   # as a sensor reads them, Timoshenko or not
+    from .frame_data import attached_reading  # as a sensor reads them, Timoshenko or not
 
     if name == "point_mass":
         places = [{"member": e["member"], "position": e["position"], "direction": d}
