@@ -1101,8 +1101,9 @@ def _attached(model: FrameModel, mesh: FrameMesh, name: str):
     displacement at each, its mass twice) or point springs ("point_spring": the displacement
     along its direction, its stiffness), None when it has none: each displacement read at
     its place by the element's shape functions, as a sensor reads it, so that the mass adds
-    m (cx cxᵀ + cy cyᵀ) to M and the spring k c cᵀ to K.  Not kept with the mesh: a fitted
-    place moves at every evaluation."""
+    m (cx cxᵀ + cy cyᵀ) to M and the spring k c cᵀ to K.  The readings are kept a few at a
+    time (:func:`~gfe_opt.frame_data.attached_reading`; a fitted place moves at every
+    evaluation, the fits of other effects read the same place again)."""
     found = [e for e in model.raw_effects if e["effect"] == name]
     if not found:
         return None
