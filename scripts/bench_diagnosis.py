@@ -513,6 +513,17 @@ def table(card) -> str:
     return "\n".join(lines)
 
 
+def scoring_model(model, final_effects):
+    """The model a stored loop is scored against: ``model`` with the material effects of
+    its ``final_effects`` (JSON), as the loop itself scores its final model (a crack's
+    compliance is read against the EI of the model it was fitted in: a material effect
+    beside it changes that; stop 55's rescoring read it against the nominal EI)."""
+    from gfe_opt.model import Effect
+
+    return model.with_effects([Effect(e["effect"], e["parameters"]) for e in final_effects
+                               if e["effect"] == "material"], check=False)
+
+
 def _rescore(args, cases) -> int:
     """Score stored loops again with this file's rules (the runs are not repeated)."""
     from types import SimpleNamespace
@@ -526,7 +537,7 @@ def _rescore(args, cases) -> int:
         case = by_name[row["name"]]
         if row["exit"]:
             continue
-        model = model_from_dict(case.model, case.name)
+        model = scoring_model(model_from_dict(case.model, case.name), row["final_effects"])
         added = [SimpleNamespace(name=e["effect"], parameters=e["parameters"])
                  for e in row["final_effects"]]
         fit = SimpleNamespace(sigma=[e.get("uncertainty", {}) for e in row["final_effects"]])
