@@ -584,6 +584,27 @@ class FitProblem:
         z = np.clip(self._per_slot(z, one), self.lower, self.upper)
         return z if moved else None
 
+    def reordered(self, z, other, within: float) -> bool:
+        """Whether ``other`` is ``z`` with the variables of slots of one effect, and of the
+        same fixed parameters, exchanged (each within ``within`` of its counterpart): two
+        instances of an effect fitted together end in either slot as one structure (two
+        cracks, the first's place and depth in the second's slot), not another end."""
+        parts, i = [], 0
+        for slot in self.slots:
+            k = len(slot.variables)
+            parts.append((slot.effect.name, repr(sorted(slot.fixed.items())),
+                          tuple(v.key for v in slot.variables), i, k))
+            i += k
+        left = list(range(len(parts)))
+        for name, fixed, keys, i, k in parts:
+            match = next((j for j in left if parts[j][:3] == (name, fixed, keys) and np.max(
+                np.abs(np.asarray(other)[parts[j][3]:parts[j][3] + k] - np.asarray(z)[i:i + k]),
+                initial=0.0) <= within), None)
+            if match is None:
+                return False
+            left.remove(match)
+        return True
+
     def _per_slot(self, z, fn) -> np.ndarray:
         z = np.array(z, dtype=float)
         i = 0
@@ -725,7 +746,8 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
         for other in converged:
             # only converged ends are compared, with a margin far above their precision
             if (other[1] - value < ALIKE_CHI2 * floor and np.max(np.abs(other[0] - z)) > 0.05
-                    and all(np.max(np.abs(other[0] - e)) > 0.05 for e in equivalent)):
+                    and all(np.max(np.abs(other[0] - e)) > 0.05 for e in equivalent)
+                    and not problem.reordered(z, other[0], 0.05)):
                 equivalent.append(other[0])
     effects = effects_of(z)
     fitted = base.with_effects(effects, check=False)
