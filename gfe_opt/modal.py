@@ -325,6 +325,9 @@ def _reduce_and_solve(disc, K, M, n_modes, groups, params):
     plan = _plan(n, per, groups)
     interior, boundary, local = plan.interior, plan.boundary, plan.local
     diagonals = {k: K.diagonal(k) for k in range(-plan.width, plan.width + 1)}
+    if sum(np.count_nonzero(d) for d in diagonals.values()) != K.count_nonzero():
+        # (an element couples its two nodes alone: nothing lies outside the band)
+        raise GfeSolverError("the condensed solve found stiffness outside the beam's band")
     rhs = np.zeros(local.shape)
     for k, (at, source) in plan.coupling.items():
         rhs.flat[at] = diagonals[k][source]
@@ -425,15 +428,20 @@ def _plan(n: int, per: int, groups: int) -> _Plan:
     size = boundary.size
     position = np.full(n_dof, -1)
     position[boundary] = np.arange(size)
-    return _Plan(coarse=coarse, boundary=boundary, position=position, interior=interior,
-                 local=local,
-                 element_group=element_group,
+    plan = _Plan(coarse=coarse, boundary=boundary, position=position, interior=interior,
+                 local=local, element_group=element_group,
                  dofs=np.arange(n)[:, None] * per + np.arange(2 * per)[None, :],
                  first=coarse[element_group] == np.arange(n),
                  last=coarse[element_group + 1] == np.arange(n) + 1,
                  width=width, band=band, coupling=coupling,
                  t_rows=np.concatenate([boundary, np.repeat(interior, 2 * per)]),
                  t_cols=np.concatenate([np.arange(size), local.ravel()]))
+    for value in vars(plan).values():   # shared by every solve of the mesh: read-only
+        for array in (value.values() if isinstance(value, dict) else [value]):
+            for a in (array if isinstance(array, tuple) else (array,)):
+                if isinstance(a, np.ndarray):
+                    a.flags.writeable = False
+    return plan
 
 
 def _interior_solver(K, plan: _Plan, diagonals: dict):

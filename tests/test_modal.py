@@ -168,6 +168,18 @@ def test_the_condensed_routes_band_reads_are_the_sparse_matrixs_entries():
     bad_diagonals = {k: bad.diagonal(k) for k in range(-plan.width, plan.width + 1)}
     fallback = modal._interior_solver(bad, plan, bad_diagonals)(x)
     assert np.array_equal(fallback, spla.splu(bad[rows][:, rows].tocsc()).solve(x))
+    # stiffness outside the band (no beam element couples nodes apart): refused, not read
+    # wrong
+    from gfe_opt.errors import GfeSolverError
+
+    far = K.tolil()
+    far[rows[3], rows[40]] = far[rows[40], rows[3]] = 1.0
+    disc = discretise(m)
+    with pytest.raises(GfeSolverError, match="outside the beam's band"):
+        modal._reduce_and_solve(disc, far.tocsr(), disc.global_matrices()[1], 5,
+                                modal.condensation_groups(401, 5), None)
+    with pytest.raises(ValueError):   # the plan, shared by every solve, is read-only
+        plan.interior[0] = 1
 
 
 def test_meshes_above_the_verified_ceiling_are_refused_with_the_limit():
