@@ -745,9 +745,10 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
                 z, value, status, success = problem.canonical(other[0]), *other[1:]
         for other in converged:
             # only converged ends are compared, with a margin far above their precision
-            if (other[1] - value < ALIKE_CHI2 * floor and np.max(np.abs(other[0] - z)) > 0.05
-                    and all(np.max(np.abs(other[0] - e)) > 0.05 for e in equivalent)
-                    and not problem.reordered(z, other[0], 0.05)):
+            if (other[1] - value < ALIKE_CHI2 * floor
+                    and np.max(np.abs(other[0] - z)) > SAME_END
+                    and all(np.max(np.abs(other[0] - e)) > SAME_END for e in equivalent)
+                    and not problem.reordered(z, other[0], SAME_END)):
                 equivalent.append(other[0])
     effects = effects_of(z)
     fitted = base.with_effects(effects, check=False)
@@ -767,6 +768,9 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
 
 #: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
 ALIKE_CHI2 = float(chdtri(1, 0.05))
+#: multistart ends this close in every scaled variable (or so, their slots of one effect
+#: exchanged) are one end, not an ``equivalent`` one
+SAME_END = 0.05
 #: values closer than this (relative) are ties, decided by their order, not by rounding: a
 #: mirror-symmetric pair of places gives χ² equal to ~1e-13 on one machine and flipped on
 #: another; the fits' own precision (:data:`FINISH_DECREMENT`) is far coarser than 1e-13 and

@@ -323,14 +323,12 @@ def _reduce_and_solve(disc, K, M, n_modes, groups, params):
     n, per = disc.n_elements, disc.dofs_per_node
     L = disc.element_length
     plan = _plan(n, per, groups)
-    interior, boundary, local = plan.interior, plan.boundary, plan.local
+    interior, boundary = plan.interior, plan.boundary
     diagonals = {k: K.diagonal(k) for k in range(-plan.width, plan.width + 1)}
     if sum(np.count_nonzero(d) for d in diagonals.values()) != K.count_nonzero():
         # (an element couples its two nodes alone: nothing lies outside the band)
         raise GfeSolverError("the condensed solve found stiffness outside the beam's band")
-    rhs = np.zeros(local.shape)
-    for k, (at, source) in plan.coupling.items():
-        rhs.flat[at] = diagonals[k][source]
+    rhs = _couplings(plan, diagonals)
     solve = _interior_solver(K, plan, diagonals)
     # basis values of every fine DOF in its group's 2·per local columns
     basis = np.zeros((disc.n_dof, 2 * per))
@@ -442,6 +440,15 @@ def _plan(n: int, per: int, groups: int) -> _Plan:
                 if isinstance(a, np.ndarray):
                     a.flags.writeable = False
     return plan
+
+
+def _couplings(plan: _Plan, diagonals: dict) -> np.ndarray:
+    """(interior DOFs, 2 per): K[interior DOF, each boundary DOF of its group], read from
+    K's ``diagonals`` (offset → :meth:`~scipy.sparse.csr_matrix.diagonal`)."""
+    out = np.zeros(plan.local.shape)
+    for k, (at, source) in plan.coupling.items():
+        out.flat[at] = diagonals[k][source]
+    return out
 
 
 def _interior_solver(K, plan: _Plan, diagonals: dict):

@@ -151,9 +151,7 @@ def test_the_condensed_routes_band_reads_are_the_sparse_matrixs_entries():
     plan = modal._plan(401, 2, modal.condensation_groups(401, 5))
     rows, cols = plan.interior, plan.boundary[plan.local]
     diagonals = {k: K.diagonal(k) for k in range(-plan.width, plan.width + 1)}
-    coupling = np.zeros(cols.shape)
-    for k, (at, source) in plan.coupling.items():
-        coupling.flat[at] = diagonals[k][source]
+    coupling = modal._couplings(plan, diagonals)
     sparse = np.stack([np.asarray(K[rows, cols[:, j]]).ravel() for j in range(4)], 1)
     assert np.count_nonzero(sparse) > 0 and np.array_equal(coupling, sparse)
     K_II = K[rows][:, rows].tocsc()
