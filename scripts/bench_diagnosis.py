@@ -205,6 +205,7 @@ def follow(model, measured, noise, result, row):
     if done.kept is not None:
         row["kept"] = done.kept
     row["caveats"] = [c.to_json() for c in done.caveats]
+    row["steps"] = done.steps
     return done.model, done.fit, done.diagnosis
 
 
