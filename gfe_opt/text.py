@@ -173,6 +173,12 @@ def format_diagnosis(result, model) -> str:
                                                        result.localisation)
                  if result.localisation else "where it fails is unknown without mode shapes")
         lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 is at the noise); {where}")
+        withheld = getattr(result, "withheld", None)
+        if withheld is not None:
+            names = " with ".join(e["effect"] for e in withheld["effects"])
+            lines.append(f"  not named: a further {names}, which explains "
+                         f"{100 * withheld['share']:.2g} % of what the present effects "
+                         "explain (as likely their own form; see the note)")
     words = list(result.realisation)
     if words and words[0].startswith("the generic-element update"):
         lines += words[:1] + [f"  {w}" for w in words[1:]]

@@ -116,6 +116,51 @@ def test_two_effects_are_found_one_after_the_other(truth, expected):
     assert last.verdict == "consistent"
 
 
+def test_a_real_further_effect_far_smaller_than_the_present_one_is_named():
+    """The data: a Christides–Barr crack at 0.4 m and a point mass of 2 % of the beam's at
+    0.15 m; the model holds the crack, fitted.  The mass lowers χ² by about 8 % of what
+    the crack explains, above ``FORM_SHARE``: it is named, where and as big as it is."""
+    from gfe_opt.diagnosis import FORM_SHARE
+    from gfe_opt.fitting import misfit, noise_of
+
+    mass = 0.02 * RHO_A * L
+    measured = reference_data(seed=8, rigidity=christides_barr(0.4, 0.5),
+                              point_masses=[(0.15, mass)])
+    cracked = update(make_model(), measured, ["crack"], **NOISE).model
+    d = diagnose(cracked, measured, **NOISE)
+    assert d.verdict == "effect_found" and d.withheld is None
+    assert d.suggested == ["point_mass"]
+    bare = misfit(make_model(), measured, noise_of(NOISE["freq_noise"],
+                                                   NOISE["shape_noise"])).chi2
+    share = (d.current.chi2 - d.best.misfit.chi2) / (bare - d.current.chi2)
+    assert 3 * FORM_SHARE < share < 30 * FORM_SHARE
+    assert abs(d.best.parameters["position"] - 0.15) < 0.02 * L
+    assert abs(d.best.parameters["mass"] / mass - 1) < 0.10
+
+
+def test_a_small_crack_beside_a_large_change_of_e_is_named():
+    """E 7 % below the model's (a wrong grade) and a crack of 5 % depth at 0.3 m; the model
+    holds the E change, fitted.  The crack lowers χ² by well under 1 % of what the E change
+    explains, but a uniform E change has no form a crack could be (every eigenvalue scaled
+    by one factor, no shape changed): it does not count in what the present effects
+    explain, and the crack is named where it is."""
+    from gfe_opt.diagnosis import FORM_SHARE
+    from gfe_opt.fitting import misfit, noise_of
+
+    from .reference import product
+
+    measured = reference_data(seed=8, rigidity=product(lambda x: np.full_like(x, 0.93),
+                                                       christides_barr(0.3, 0.05)))
+    softer = update(make_model(), measured, ["material"], **NOISE).model
+    d = diagnose(softer, measured, **NOISE)
+    assert d.verdict == "effect_found" and d.withheld is None and d.suggested == ["crack"]
+    bare = misfit(make_model(), measured, noise_of(NOISE["freq_noise"],
+                                                   NOISE["shape_noise"])).chi2
+    assert (d.current.chi2 - d.best.misfit.chi2) / (bare - d.current.chi2) < FORM_SHARE / 2
+    assert abs(d.best.parameters["position"] - 0.3) < 0.02 * L
+    assert abs(d.best.parameters["depth_ratio"] - 0.05) < 0.02
+
+
 def test_data_the_model_fits_are_consistent_and_no_support_effect_is_called():
     """Parameters the data cannot determine are never significant: a mass or a spring on
     a pinned support does nothing, so nothing may be found in the model's own behaviour."""
