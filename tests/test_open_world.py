@@ -173,7 +173,12 @@ def test_a_notch_in_a_pinned_continuum_with_noise_above_the_stated_is_found():
     completes it, but shear with a crack explains the data (the continuum's own shear
     deformation and the notch; before the uniform change's rule of the selection E with a
     crack, which fits as well as the profile and leaves a difference, was the finding):
-    that pair is the finding, and the loop ends with the crack at the notch."""
+    that pair is the finding, and the loop ends with the crack at the notch.  What the pair
+    leaves (the continuum's pins at mid-height, which a support that translates fitted and
+    the loop then ended ``consistent``) is below 1 % of what the pair explains: since stop
+    57 it is withheld as the present effects' own form, and the loop ends ``unexplained``
+    (right for a truth outside the family, as the campaign scores it)."""
+    from gfe_opt.diagnosis import FORM_SHARE
     from gfe_opt.model import model_from_dict
 
     from .truths import continuum_case
@@ -193,7 +198,9 @@ def test_a_notch_in_a_pinned_continuum_with_noise_above_the_stated_is_found():
         model = update(model, measured, list(d.suggested),
                        drop=[swap["index"]] if swap else ()).model
     assert sorted(first.suggested) == ["crack", "shear"], first.notes
-    assert d.verdict == "consistent", (d.verdict, d.notes)
+    assert d.verdict == "unexplained", (d.verdict, d.notes)
+    assert 0 < d.withheld["share"] < FORM_SHARE
+    assert sorted(e.name for e in model.effects) == ["crack", "shear"]
     cracks = [e.parameters["position"] for e in model.effects if e.name == "crack"]
     assert len(cracks) == 1 and abs(cracks[0] - notch) <= 0.02 * L, (cracks, notch)
 
