@@ -126,8 +126,8 @@ NO_GAIN = 0.5
 #: 0.02-0.94 %) were added by confidently wrong loops or not needed by right ones, and the
 #: smallest a right loop needed was at 4.7 %; 1 % is the round value between, at its low
 #: end (a refused effect that is real costs too).  Checked on seed 2200 (README, "Stop
-#: 57").  A replacement (``replace``), a pair suggested at once and the first diagnosis
-#: (nothing present) are not held to it.
+#: 57").  A replacement (``replace``) and the first diagnosis (nothing present) are not
+#: held to it; a pair is judged as a whole, never by its second effect alone.
 FORM_SHARE = 0.01
 
 
@@ -1103,6 +1103,10 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             for f in ranked:
                 f.significant = False
             verdict, suggested, together = "unexplained", [], None
+            if band is not None and words is not None:   # read against no finding
+                from .realisation import describe_profile
+
+                words = describe_profile(band)
     remaining = None
     if verdict == "effect_found":
         finding = together if suggested and together is not None else ranked[0]
@@ -1175,10 +1179,12 @@ def _form_of_present(model, measured, noise, C, ref_misfit, finding) -> dict | N
             "note": f"the best further {names} ({finding.describe()}) lowers χ² by "
                     f"{gain:.3g} (χ²/n {ref_misfit.chi2_per_residual:.3g} -> "
                     f"{finding.misfit.chi2_per_residual:.3g}), {100 * gain / carried:.2g} % "
-                    f"of the {carried:.3g} the effects present explain: a difference this "
+                    f"of the {carried:.3g} the effects present explain"
+                    + (" (their uniform E change not counted)" if uniform else "")
+                    + ": a difference this "
                     "small next to them is as likely their own form (another crack law, the "
                     "mass a notch removed, the beam theory) as a further effect, and it is "
-                    f"not named (to add it all the same: gfe-opt update MODEL MEASURED "
+                    "not named (to add it all the same: gfe-opt update MODEL MEASURED "
                     + " ".join(f"--add {e.name}" for e in added) + ")"}
 
 

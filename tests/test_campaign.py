@@ -81,6 +81,10 @@ def test_what_another_crack_law_leaves_is_not_named_as_a_further_effect():
     assert VERDICT_WORDS["unexplained"] in text
     assert (f"not named: a further {' with '.join(names)}, which explains "
             f"{100 * out['share']:.2g} % of what the present effects explain") in text
+    # with the generic update read in words, none credits the withheld effect
+    again = diagnose(done.model, measured, realise=True)
+    assert again.verdict == "unexplained" and again.withheld is not None
+    assert again.realisation and not any("the fitted" in w for w in again.realisation)
 
 
 @pytest.mark.slow  # about 3 minutes: .ci/run runs it with the other slow studies
