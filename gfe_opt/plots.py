@@ -262,10 +262,11 @@ def localisation(x, residual, comac, length, supports=("pinned", "pinned"), plac
 
 
 def candidate_errors(fits, baseline_pct, together=None, verdict=None, *, length=None,
-                     supports=("pinned", "pinned"), findings=(), elsewhere=()):
+                     supports=("pinned", "pinned"), findings=(), elsewhere=(), note=None):
     """Frequency error left by each candidate effect (significant ones coloured) and, when
     a pair is suggested, by the pair (hatched, on top); with ``findings`` and ``elsewhere``
-    (as for :func:`structure_sketch`) and the ``length``, the structure with them below."""
+    (as for :func:`structure_sketch`) and the ``length``, the structure with them below;
+    ``note`` (what the diagnosis did not name for its share) above the bars."""
     sketch = None
     if findings and length is not None:
         fig = _figure(7.0, 4.4)
@@ -292,7 +293,8 @@ def candidate_errors(fits, baseline_pct, together=None, verdict=None, *, length=
     for bar, value in zip(bars, values[::-1]):
         ax.annotate(f"{value:.3g} %", (value, bar.get_y() + bar.get_height() / 2),
                     textcoords="offset points", xytext=(3, 0), va="center", fontsize=7)
-    ax.set_title("best first; green: the effect found, pale green: significant but not "
+    ax.set_title(("" if note is None else note + "\n")
+                 + "best first; green: the effect found, pale green: significant but not "
                  "the answer", fontsize=8)
     if verdict:
         fig.suptitle(f"verdict: {verdict}", fontsize=10, fontweight="bold")

@@ -60,6 +60,15 @@ def verdict_title(diagnosis) -> str:
     return VERDICT_WORDS[diagnosis.verdict]
 
 
+def withheld_title(diagnosis) -> str | None:
+    """What a diagnosis did not name for its share (:func:`~gfe_opt.text.withheld_words`,
+    as the text says it), or None."""
+    from .text import withheld_words
+
+    withheld = getattr(diagnosis, "withheld", None)
+    return None if withheld is None else withheld_words(withheld)
+
+
 def diagnosis_figures(diagnosis, model) -> dict:
     """Candidate errors; with the generic update: its stiffness profile against the noise
     band and what the effect found would show, the structure with the located place and
@@ -71,7 +80,8 @@ def diagnosis_figures(diagnosis, model) -> dict:
 
         figs = {"candidates.png": plots.candidate_errors(
             diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
-            verdict=verdict_title(diagnosis))} if diagnosis.fits else {}
+            verdict=verdict_title(diagnosis), note=withheld_title(diagnosis))} \
+            if diagnosis.fits else {}
         figs.update(frame_diagnosis_figures(diagnosis, model, verdict_title(diagnosis),
                                             found))
         if diagnosis.profile_band is not None:
@@ -84,7 +94,8 @@ def diagnosis_figures(diagnosis, model) -> dict:
     figs = {"candidates.png": plots.candidate_errors(
         diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
         verdict=verdict_title(diagnosis), length=model.length, supports=model.supports,
-        findings=found, elsewhere=elsewhere(diagnosis))} if diagnosis.fits else {}
+        findings=found, elsewhere=elsewhere(diagnosis), note=withheld_title(diagnosis))} \
+        if diagnosis.fits else {}
     band = diagnosis.profile_band
     best = diagnosis.best
     if band is not None:

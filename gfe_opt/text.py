@@ -21,6 +21,14 @@ VERDICT_WORDS = {
 }
 
 
+def withheld_words(withheld: dict) -> str:
+    """``not named: a further stiffness_profile, 0.44 % of what the present effects
+    explain`` (a diagnosis's ``withheld``; the text and the candidates figure)."""
+    names = " with ".join(e["effect"] for e in withheld["effects"])
+    return (f"not named: a further {names}, {100 * withheld['share']:.2g} % of what the "
+            "present effects explain")
+
+
 def misfit_line(m, label: str = "") -> str:
     """``frequency error 5.591 % rms, mean MAC 0.9919, χ²/n 663.6``."""
     head = f"{label}: " if label else ""
@@ -175,10 +183,8 @@ def format_diagnosis(result, model) -> str:
         lines.append(f"  χ²/n {_ratio(now.chi2_per_residual)} (1 is at the noise); {where}")
         withheld = getattr(result, "withheld", None)
         if withheld is not None:
-            names = " with ".join(e["effect"] for e in withheld["effects"])
-            lines.append(f"  not named: a further {names}, which explains "
-                         f"{100 * withheld['share']:.2g} % of what the present effects "
-                         "explain (as likely their own form; see the note)")
+            lines.append(f"  {withheld_words(withheld)} (as likely their own form; see the "
+                         "note)")
     words = list(result.realisation)
     if words and words[0].startswith("the generic-element update"):
         lines += words[:1] + [f"  {w}" for w in words[1:]]

@@ -74,13 +74,18 @@ def test_what_another_crack_law_leaves_is_not_named_as_a_further_effect():
     names = [e["effect"] for e in out["effects"]]
     assert any(f"not named (to add it all the same: gfe-opt update MODEL MEASURED "
                f"{' '.join('--add ' + n for n in names)})" in n for n in last.notes)
-    # the text says the same as the JSON: the verdict, what is not named and its share
+    # the text and the figure say the same as the JSON: the verdict, what is not named
+    # and its share
+    from gfe_opt.report import diagnosis_figures
     from gfe_opt.text import VERDICT_WORDS, format_diagnosis
 
+    said = (f"not named: a further {' with '.join(names)}, {100 * out['share']:.2g} % of "
+            "what the present effects explain")
     text = format_diagnosis(last, done.model)
-    assert VERDICT_WORDS["unexplained"] in text
-    assert (f"not named: a further {' with '.join(names)}, which explains "
-            f"{100 * out['share']:.2g} % of what the present effects explain") in text
+    assert VERDICT_WORDS["unexplained"] in text and said in text
+    figure = diagnosis_figures(last, done.model)["candidates.png"]
+    assert said in figure.axes[0].get_title()
+    assert VERDICT_WORDS["unexplained"] in figure._suptitle.get_text()
     # with the generic update read in words, none credits the withheld effect
     again = diagnose(done.model, measured, realise=True)
     assert again.verdict == "unexplained" and again.withheld is not None
