@@ -527,22 +527,16 @@ def scoring_model(model, final_effects):
 
 def _rescore(args, cases) -> int:
     """Score stored loops again with this file's rules (the runs are not repeated)."""
-    from types import SimpleNamespace
 
-    from gfe_opt.model import model_from_dict
 
     doc = json.loads(args.rescore.read_text())
     by_name = {c.name: c for c in cases}
-    rows = doc["cases"]
+    rows = [r for r in doc["cases"] if r["name"] in by_name]
+    doc["cases"] = rows
+    if args.form_sweep:
+        _form_sweep(rows, by_name)
     for row in rows:
-        case = by_name[row["name"]]
-        if row["exit"]:
-            continue
-        model = scoring_model(model_from_dict(case.model, case.name), row["final_effects"])
-        added = [SimpleNamespace(name=e["effect"], parameters=e["parameters"])
-                 for e in row["final_effects"]]
-        fit = SimpleNamespace(sigma=[e.get("uncertainty", {}) for e in row["final_effects"]])
-        _score(row, case, model, fit, added=added)
+        _rescore_row(row, by_name[row["name"]])
     card = scorecard(rows)
     doc["scorecard"] = card
     doc["targets"] = targets(rows)
@@ -552,6 +546,79 @@ def _rescore(args, cases) -> int:
         args.json.write_text(json.dumps(doc, indent=1, default=float))
     _print(doc, args.sweep)
     return 0
+
+
+def _rescore_row(row, case) -> None:
+    """Score one stored loop again (its ``final_effects`` on the case's model)."""
+    from types import SimpleNamespace
+
+    from gfe_opt.model import model_from_dict
+
+    if row["exit"]:
+        return
+    model = scoring_model(model_from_dict(case.model, case.name), row["final_effects"])
+    added = [SimpleNamespace(name=e["effect"], parameters=e["parameters"])
+             for e in row["final_effects"]]
+    fit = SimpleNamespace(sigma=[e.get("uncertainty", {}) for e in row["final_effects"]])
+    _score(row, case, model, fit, added=added)
+
+
+#: the shares :func:`_form_sweep` tries (selection step 10's ``FORM_SHARE`` among them)
+FORM_SHARES = (0.001, 0.003, 0.01, 0.03, 0.1)
+
+
+def further_shares(row) -> list:
+    """Per diagnosis of a stored loop (its ``steps``): the share of what the present
+    effects explain that the suggested further effects explain (χ² of the first diagnosis,
+    the model without effects, minus χ² now, against χ² now minus the suggestion's), None
+    where the rule of selection step 10 does not look (the first diagnosis, no suggestion,
+    a replacement: the next model holds fewer effects than added).  Approximate where the
+    loop holds a uniform E change, which the rule does not count."""
+    steps = row.get("steps") or []
+    out = []
+    for k, st in enumerate(steps):
+        later = steps[k + 1]["effects"] if k + 1 < len(steps) else None
+        replaced = later is not None and len(later) < len(st["effects"]) + len(st["proposed"])
+        if k == 0 or st["verdict"] != "effect_found" or st["proposed_chi2"] is None \
+                or replaced:
+            out.append(None)
+            continue
+        explained = steps[0]["chi2"] - st["chi2"]
+        out.append((st["chi2"] - st["proposed_chi2"]) / explained if explained > 0 else None)
+    return out
+
+
+def _form_sweep(rows, by_name) -> None:
+    """Print the scorecard the stored loops would have if each had stopped (``unexplained``)
+    at the first diagnosis whose further effects explain less than each of
+    :data:`FORM_SHARES` (:func:`further_shares`): how selection step 10's share was chosen,
+    on loops run without it (``docs/campaign-*-steps-before-form.json``).  Loops run with
+    it stopped where it held: shares below the one they ran with cannot be judged there."""
+    import copy
+
+    print(f"{'share':>8}{'verdicts right':>16}{'conf. wrong':>13}{'false alarms':>14}"
+          f"{'stopped':>9}")
+    for share in FORM_SHARES:
+        scored = []
+        for row in rows:
+            shares = further_shares(row)
+            k = next((i for i, v in enumerate(shares) if v is not None and v < share), None)
+            stop = copy.deepcopy(row)
+            if k is not None and not row["exit"]:
+                steps = row["steps"]
+                stop["verdicts"] = row["verdicts"][:k] + ["unexplained"]
+                stop["caveats"] = row["caveats"][:sum(s["caveats"] for s in steps[:k + 1])]
+                stop["final_effects"] = steps[k]["effects"]
+                stop["stopped"] = True
+            _rescore_row(stop, by_name[row["name"]])
+            if row["exit"]:   # (as run_case scores a loop that failed)
+                stop.update(class_right=False, verdict_right=False,
+                            false_alarm=_no_local(by_name[row["name"]]))
+            scored.append(stop)
+        card = scorecard(scored)["all"]
+        print(f"{share:>8.3g}{card['verdict_right_pct']:>15.1f}%{card['confidently_wrong']:>13}"
+              f"{card['false_alarms']:>14}{sum(bool(r.get('stopped')) for r in scored):>9}")
+    print()
 
 
 def _print(doc, with_sweep) -> None:
@@ -586,6 +653,10 @@ def main(argv=None) -> int:
                         help="multiply every measured frequency and shape value by 1 + EPS "
                         "times a normal draw (seeded by the case), e.g. 1e-9: which "
                         "decisions hinge on rounding, on one machine")
+    parser.add_argument("--form-sweep", action="store_true",
+                        help="with --rescore: the scorecard had each loop stopped where its "
+                        "further effects explain less than each of a few shares of what "
+                        "the present ones do (how selection step 10's 1 %% was chosen)")
     parser.add_argument("--sweep", action="store_true",
                         help="also print the first diagnosis under other significance "
                         "levels and size thresholds (what chose α = 1e-3 and 3 σ)")
