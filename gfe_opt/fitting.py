@@ -318,6 +318,7 @@ class Slot:
     start: dict
     variables: tuple
     added: bool
+    found: bool = True   # the effect it gives is fitted (added, or found before)
 
 
 def slots_for(model: Model, adding) -> list[Slot]:
@@ -336,7 +337,8 @@ def slots_for(model: Model, adding) -> list[Slot]:
             raise GfeInputError(None, e.name, f"needs {', '.join(missing)} to be fitted")
         held = any(n in names for n in kind.redundant_with)
         variables = () if held else tuple(kind.variables(base, fixed))
-        out.append(Slot(kind, fixed, dict(e.parameters), variables, added))
+        out.append(Slot(kind, fixed, dict(e.parameters), variables, added,
+                        added or e.found))
     return out
 
 
@@ -547,10 +549,10 @@ class FitProblem:
         for slot in self.slots:
             k = len(slot.variables)
             if k == 0:
-                out.append(Effect(slot.effect.name, slot.start))
+                out.append(Effect(slot.effect.name, slot.start, slot.found))
             else:
                 out.append(Effect(slot.effect.name, slot.effect.to_physical(
-                    self.base, slot.variables, z[i:i + k], slot.fixed)))
+                    self.base, slot.variables, z[i:i + k], slot.fixed), slot.found))
             i += k
         return out
 

@@ -239,8 +239,14 @@ def frame_from_dict(data: dict, where: str = "model") -> FrameModel:
 
     model = FrameModel(name=name, nodes=nodes, members=tuple(members),
                        supports=tuple(supports), source=where)
-    effects = tuple(_effect(model, raw, where, f"effects[{i}].")
-                    for i, raw in enumerate(_array(data, "effects", where, required=False)))
+    from .model import pop_found
+
+    effects = []
+    for i, raw in enumerate(_array(data, "effects", where, required=False)):
+        raw = dict(raw)   # (a table: _array checks)
+        found = pop_found(raw, where, f"effects[{i}].")
+        effects.append(replace(_effect(model, raw, where, f"effects[{i}]."), found=found))
+    effects = tuple(effects)
     check_repeats(effects, where)
     return FrameModel(name=name, nodes=nodes, members=tuple(members),
                       supports=tuple(supports), effects=effects, source=where)
@@ -562,7 +568,9 @@ def frame_to_dict(model: FrameModel) -> dict:
     if model.supports:
         data["supports"] = [{"node": n, "type": t} for n, t in model.supports]
     if model.effects:
-        data["effects"] = model.raw_effects
+        from .model import effect_to_dict
+
+        data["effects"] = [effect_to_dict(e) for e in model.effects]
     return data
 
 

@@ -21,6 +21,7 @@ The file form is a contract (see README, "Model file")::
     effect = "crack"
     position = 0.19
     depth_ratio = 0.5
+    found = true             # optional: fitted by gfe-opt (update writes it), not known
 """
 
 from __future__ import annotations
@@ -44,10 +45,14 @@ BAR_MASS_MODELS = ("consistent", "lumped", "harmonic", "minimum_error")
 @dataclass(frozen=True)
 class Effect:
     """One instance of a physical effect in a model: its name (a registered
-    :class:`~gfe_opt.effects.EffectType`) and physical parameters (SI)."""
+    :class:`~gfe_opt.effects.EffectType`) and physical parameters (SI).  ``found``: fitted
+    to the data by gfe-opt (``update`` adds it so), not a known part of the structure the
+    user modelled; selection step 10 weighs further effects against what found ones
+    explain (not part of equality: the same effect either way)."""
 
     name: str
     parameters: dict[str, Any]
+    found: bool = field(default=False, compare=False)
 
     def __str__(self) -> str:
         args = ", ".join(f"{k}={_fmt(v)}" for k, v in self.parameters.items())
@@ -136,7 +141,8 @@ class Model:
         if check:
             effects = tuple(Effect(e.name, validate_effect(self, e.name, dict(e.parameters),
                                                            self.source or "model",
-                                                           f"effects[{i}]."))
+                                                           f"effects[{i}]."),
+                                   e.found)
                             for i, e in enumerate(effects))
             check_repeats(effects, self.source or "model")
         return replace(self, effects=effects)
@@ -259,7 +265,9 @@ def model_from_dict(data: dict, where: str = "model") -> Model:
         name_ = raw.pop("effect", None)
         if name_ is None:
             raise GfeInputError(where, f"effects[{i}].effect", "missing (the effect's name)")
-        effects.append(Effect(name_, validate_effect(model, name_, raw, where, f"effects[{i}].")))
+        found = pop_found(raw, where, f"effects[{i}].")
+        effects.append(Effect(name_, validate_effect(model, name_, raw, where, f"effects[{i}]."),
+                              found))
     check_repeats(effects, where)
     return replace(model, effects=tuple(effects))
 
@@ -418,8 +426,23 @@ def model_to_dict(model: Model) -> dict:
             data["section"]["h"] = model.depth
     data["supports"] = {"left": model.supports[0], "right": model.supports[1]}
     if model.effects:
-        data["effects"] = [{"effect": e.name, **e.parameters} for e in model.effects]
+        data["effects"] = [effect_to_dict(e) for e in model.effects]
     return data
+
+
+def effect_to_dict(effect: Effect) -> dict:
+    """An effect as a model file writes it: ``{"effect": name, **parameters}``, and
+    ``found = true`` when gfe-opt fitted it (:attr:`Effect.found`)."""
+    return {"effect": effect.name, **effect.parameters, **({"found": True} if effect.found
+                                                           else {})}
+
+
+def pop_found(raw: dict, where: str, prefix: str) -> bool:
+    """Take an effect table's optional ``found`` flag out of ``raw`` (true or false)."""
+    found = raw.pop("found", False)
+    if not isinstance(found, bool):
+        raise GfeInputError(where, prefix + "found", f"must be true or false, got {found!r}")
+    return found
 
 
 def save_model(model: Model, path, *, force: bool = False, protect=()) -> None:

@@ -161,6 +161,67 @@ def test_a_small_crack_beside_a_large_change_of_e_is_named():
     assert abs(d.best.parameters["depth_ratio"] - 0.05) < 0.02
 
 
+def test_a_crack_beside_a_heavy_mass_the_user_modelled_is_named():
+    """A 0.3 kg mass at 0.4 m (22 % of the beam's), known and in the model file, and a
+    crack of 20 % depth at 0.15 m in the data.  The mass explains far more than the crack
+    does (against a beam without it), but it is not a finding whose form a remainder could
+    be: the crack is named where and as deep as it is, and the loop ends ``consistent``.
+    The same model with the mass marked found (as a loop that fitted it would hold it)
+    withholds the crack as that mass's own form (selection step 10): the flag decides,
+    and a model file carries it (``found = true``, written by ``update``)."""
+    from dataclasses import replace
+
+    from gfe_opt.diagnosis import FORM_SHARE
+
+    mass = 0.3
+    measured = reference_data(seed=8, rigidity=christides_barr(0.15, 0.2),
+                              point_masses=[(0.4, mass)])
+    known = make_model().with_effects([Effect("point_mass", {"position": 0.4, "mass": mass})])
+    d = diagnose(known, measured, **NOISE)
+    assert d.verdict == "effect_found" and d.withheld is None, (d.verdict, d.notes)
+    assert d.suggested == ["crack"]
+    assert abs(d.best.parameters["position"] - 0.15) < 0.02 * L
+    assert abs(d.best.parameters["depth_ratio"] - 0.2) < 0.03
+    cracked = update(known, measured, ["crack"], **NOISE).model
+    assert [e.found for e in cracked.effects] == [False, True]
+    assert diagnose(cracked, measured, **NOISE).verdict == "consistent"
+    fitted = known.with_effects([replace(e, found=True) for e in known.effects])
+    withheld = diagnose(fitted, measured, **NOISE)
+    assert withheld.verdict == "unexplained"
+    assert [e["effect"] for e in withheld.withheld["effects"]] == ["crack"]
+    assert 0 < withheld.withheld["share"] < FORM_SHARE
+
+
+def test_a_model_file_keeps_which_effects_were_found(tmp_path):
+    """``found = true`` in an effect table round-trips (a beam's and a frame's file); a flag
+    that is not a boolean is an input error naming its place; the flag is not part of an
+    effect's equality."""
+    from gfe_opt.errors import GfeInputError
+    from gfe_opt.model import load_model, model_from_dict, model_to_dict, save_model
+    from gfe_opt.problems import portal_frame
+
+    model = make_model().with_effects([
+        Effect("point_mass", {"position": 0.4, "mass": 0.3}),
+        Effect("crack", {"position": 0.15, "depth_ratio": 0.2}, found=True)])
+    save_model(model, tmp_path / "m.toml")
+    again = load_model(tmp_path / "m.toml")
+    assert [e.found for e in again.effects] == [False, True]
+    assert "found = true" in (tmp_path / "m.toml").read_text()
+    assert again.effects == model.effects
+    data = model_to_dict(model)
+    data["effects"][1]["found"] = "yes"
+    with pytest.raises(GfeInputError, match=r"effects\[1\]\.found"):
+        model_from_dict(data, "m.toml")
+    portal = portal_frame()
+    frame = portal.with_effects([
+        Effect("crack", {"member": "left-column", "position": 0.1, "depth_ratio": 0.3},
+               found=True),
+        Effect("point_mass", {"member": "beam", "position": 0.2, "mass": 0.1})])
+    save_model(frame, tmp_path / "f.toml")
+    assert [e.found for e in load_model(tmp_path / "f.toml", frames=True).effects] == [
+        True, False]
+
+
 def test_data_the_model_fits_are_consistent_and_no_support_effect_is_called():
     """Parameters the data cannot determine are never significant: a mass or a spring on
     a pinned support does nothing, so nothing may be found in the model's own behaviour."""
