@@ -1099,6 +1099,12 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         finding = together if suggested and together is not None else ranked[0]
         withheld = _form_of_present(model, measured, noise, C, ref_misfit, finding)
         if withheld is not None:
+            # the notes that said to add what is withheld give way to the one that says
+            # why it is not named ("the stiffness_profile explains it to the noise" just
+            # before "... not named" read as a contradiction)
+            names = {e["effect"] for e in withheld["effects"]}
+            notes = [n for n in notes if not (n.endswith(RECOMMENDING) and any(
+                name in n for name in names))]
             notes.append(withheld.pop("note"))
             for f in ranked:
                 f.significant = False
@@ -1147,6 +1153,11 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                      notes=notes, remaining=remaining,
                      offered=offered if verdict == "unexplained" else [],
                      replace=replace, not_needed=not_needed, withheld=withheld)
+
+
+#: how the notes that recommend adding an effect end (a profile that explains the rest, a
+#: pair to add together): withdrawn when selection step 10 withholds that effect
+RECOMMENDING = ("explains it to the noise", "add them together")
 
 
 def _form_of_present(model, measured, noise, C, ref_misfit, finding) -> dict | None:
