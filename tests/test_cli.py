@@ -157,7 +157,7 @@ def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_p
     assert set(data["effects"][0]) == {"effect", "parameters", "uncertainty", "bounds"}
     assert data["after"]["freq_error_rms_pct"] < 0.1 * data["before"]["freq_error_rms_pct"]
     assert data["effects"][0]["effect"] == "crack"
-    assert [e.name for e in load_model(out).effects] == ["crack"]
+    assert [(e.name, e.found) for e in load_model(out).effects] == [("crack", True)]
     # --out never overwrites its input, nor an existing file without --force
     assert main(["update", str(model), str(measured), "--add", "crack", "--out",
                  str(model)]) == 2
