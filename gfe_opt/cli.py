@@ -109,7 +109,8 @@ def build_parser() -> argparse.ArgumentParser:
     noise_options(g)
     output_options(g)
 
-    u = sub.add_parser("update", help="add effects, fit their parameters, see the error fall")
+    u = sub.add_parser("update", help="add effects, fit their parameters, see the error fall "
+                       "(with neither --add nor --drop: re-estimate the model's effects)")
     u.add_argument("model", help="model file (.toml)")
     u.add_argument("measured", help="measured modes (.json, .csv, .uff, .unv)")
     u.add_argument("--add", action="append", default=[], metavar="EFFECT",
@@ -415,10 +416,11 @@ def cmd_diagnose(args) -> int:
 
 
 def cmd_update(args) -> int:
-    if not args.add and not args.drop:
-        raise GfeInputError("update", None, "nothing to do: give an effect to add (--add) or "
-                            "a present one to take out (--drop)")
     model, measured = _inputs(args, frames=True)
+    if not args.add and not args.drop and not model.effects:
+        raise GfeInputError("update", None, "nothing to do: give an effect to add (--add) or "
+                            "a present one to take out (--drop); with neither, update "
+                            "re-estimates the model's effects, and this model has none")
     from .model import parse_effect, save_model
 
     effects = [parse_effect(a, model) for a in args.add]

@@ -409,7 +409,7 @@ def run_case(case: dict) -> dict:
     first = diagnose(model, measured, **noise)
     first_chi2 = first.current.chi2_per_residual
     row = {"verdicts": [first.verdict], "added": []}
-    model, _, _ = bench_diagnosis.follow(model, measured, noise, first, row)
+    model, _, _, _ = bench_diagnosis.follow(model, measured, noise, first, row)
     # the caveats of every diagnosis of the loop (``Followed.caveats``, as the JSON gives
     # them; before stop 56 only the first diagnosis's were read)
     caveats = [SimpleNamespace(kind=c["kind"], note=c["note"], alternatives=[

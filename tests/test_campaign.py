@@ -261,7 +261,7 @@ def test_the_users_loop_takes_out_what_the_others_make_unnecessary():
     first = diagnose(model, measured, **NOISE)
     assert first.verdict == "consistent" and first.not_needed
     row = {"verdicts": [first.verdict], "added": []}
-    final, fit, last = bench_diagnosis.follow(model, measured, NOISE, first, row)
+    final, fit, last, _ = bench_diagnosis.follow(model, measured, NOISE, first, row)
     assert row["dropped"] == ["point_mass"] and row["added"] == [] and "kept" not in row
     assert [e.name for e in final.effects] == ["crack"]
     assert abs(final.effects[0].parameters["position"] - 0.19) < 0.02 * L

@@ -188,9 +188,15 @@ def test_update_writes_a_model_that_diagnose_continues_from(files, capsys, tmp_p
     assert data["effects"] == [] and not load_model(bare).effects
     # the zone stood for the crack: without it the misfit is the model's without effects
     assert data["after"]["chi2_per_residual"] > 10 * data["before"]["chi2_per_residual"]
-    assert main(["update", str(again), str(measured)]) == 2
+    assert main(["update", str(bare), str(measured)]) == 2
     err = capsys.readouterr().err
     assert "nothing to do" in err and err.count("\n") == 1
+    # neither --add nor --drop: the present effects re-estimated (what a diagnosis's note
+    # says to run when an effect the user modelled is not as the data read it)
+    assert main(["update", str(again), str(measured), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [e["effect"] for e in data["effects"]] == ["section_loss"]
+    assert data["after"]["chi2_per_residual"] <= data["before"]["chi2_per_residual"]
 
 
 @pytest.mark.parametrize("add,match", [("rust", "unknown effect 'rust'"),

@@ -182,6 +182,7 @@ def test_a_crack_beside_a_heavy_mass_the_user_modelled_is_named():
     assert d.suggested == ["crack"]
     assert abs(d.best.parameters["position"] - 0.15) < 0.02 * L
     assert abs(d.best.parameters["depth_ratio"] - 0.2) < 0.03
+    assert not [n for n in d.notes if "is not as the data read it" in n]
     cracked = update(known, measured, ["crack"], **NOISE).model
     assert [e.found for e in cracked.effects] == [False, True]
     assert diagnose(cracked, measured, **NOISE).verdict == "consistent"
@@ -190,6 +191,23 @@ def test_a_crack_beside_a_heavy_mass_the_user_modelled_is_named():
     assert withheld.verdict == "unexplained"
     assert [e["effect"] for e in withheld.withheld["effects"]] == ["crack"]
     assert 0 < withheld.withheld["share"] < FORM_SHARE
+
+
+def test_a_known_mass_that_is_not_as_modelled_is_said():
+    """The model file gives a 0.2 kg mass at 0.4 m; the structure carries 0.3 kg there.
+    Re-estimated, the mass explains the data (the verdict reads the model so), and a note
+    says that the known mass is not as modelled, with both values and the command that
+    re-estimates it; a known mass as modelled draws no such note (the test above)."""
+    measured = reference_data(seed=8, point_masses=[(0.4, 0.3)])
+    known = make_model().with_effects([Effect("point_mass", {"position": 0.4, "mass": 0.2})])
+    d = diagnose(known, measured, **NOISE)
+    assert d.verdict == "consistent"
+    (note,) = [n for n in d.notes if "is not as the data read it" in n]
+    assert "point_mass (effects[0])" in note and "mass 0.2 -> 0.3" in note
+    assert "gfe-opt update MODEL MEASURED writes it re-estimated" in note
+    again = update(known, measured, [], **NOISE).model
+    assert abs(again.effects[0].parameters["mass"] / 0.3 - 1) < 0.02
+    assert again.effects[0].found is False   # re-estimated, still the user's known mass
 
 
 def test_a_model_file_keeps_which_effects_were_found(tmp_path):

@@ -221,8 +221,10 @@ CLASS_SUPPORTS = {
 
 
 def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=False,
-         law=None) -> Case:
-    """One case of ``klass`` (a class of :data:`ANSWERS`, or "shear"), drawn from ``seed``."""
+         law=None, known=None) -> Case:
+    """One case of ``klass`` (a class of :data:`ANSWERS`, or "shear"), drawn from ``seed``.
+    ``known``: (position m, mass kg) of an attached mass in the truth and in the model
+    file (:func:`known_campaign`); the case's other draws are as without it."""
     rng = np.random.default_rng(seed)
     L = BEAM["length"]
     if klass == "shear":
@@ -242,9 +244,11 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
         hidden.append(hid)
         each.append(ch)
 
+    given = [] if known is None else [{"point_masses": [tuple(known)]}]
+
     def truth_beam(parts):
         return ReferenceBeam(length=L, EI=EI, rho_a=rho_a, elements=800,
-                             **_merge(supports, parts))
+                             **_merge(supports, given + parts))
 
     beam = truth_beam(each)
     n_modes = int(rng.integers(3, 9))
@@ -261,7 +265,7 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
     rigid = 2 if supports == ("free", "free") else 0
     freqs, shapes = beam.measure(n_modes + rigid, x, shape_noise=0.0, freq_noise=0.0)
     freqs, shapes = freqs[rigid:], shapes[:, rigid:]
-    plain = ReferenceBeam(length=L, EI=EI, rho_a=rho_a, supports=supports, elements=800)
+    plain = truth_beam([])
     f0, y0 = plain.measure(n_modes + rigid, x, shape_noise=0.0, freq_noise=0.0)
     signal = _signal(freqs, shapes, f0[rigid:], y0[:, rigid:], factor, frequency_only)
     marginal = (signal,) if len(each) == 1 else ()
@@ -277,8 +281,12 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
     stated = (factor * FREQ_NOISE, factor * SHAPE_NOISE) if rng.integers(2) else None
     group = "pair" if pair_with else klass
     law_tag = "-" + hidden[0].law if hidden and hidden[0].law else ""
-    return Case(f"{group}{law_tag}-{name_support}-{seed}", group,
-                model_dict(supports, elements), x, freqs,
+    model = model_dict(supports, elements)
+    if known is not None:
+        model["effects"] = [{"effect": "point_mass", "position": float(known[0]),
+                             "mass": float(known[1])}]
+        group, law_tag = "known", f"-{klass}{law_tag}"
+    return Case(f"{group}{law_tag}-{name_support}-{seed}", group, model, x, freqs,
                 None if frequency_only else shapes, hidden, stated, factor,
                 in_family=all(hd.law in ("", "christides_barr") for hd in hidden)
                 and klass not in ("taper",), signal=signal, marginal=marginal)
@@ -431,6 +439,30 @@ def campaign(seed: int = 2100, subset: int | None = None) -> list[Case]:
             cases.append(continuum_case(s) if klass == "continuum" else
                          draw(klass, s, pair_with=pair, frequency_only=freq_only))
     return cases[::subset] if subset else cases
+
+
+#: the known-mass cases (:func:`known_campaign`): (hidden class, how many)
+KNOWN_PLAN = [("crack", 4), ("zone", 2), ("mass", 2), ("spring", 2), ("none", 2)]
+
+
+def known_campaign(seed: int = 2100) -> list[Case]:
+    """Cases whose model file holds a known attached mass (in the truth too: a motor, a
+    sensor block), 5–60 % of the beam's mass (log-uniform) at 10–90 % of its length, and
+    one hidden effect of :data:`KNOWN_PLAN` beside it (or none): the mass is part of the
+    structure the user modelled, not a finding, and what is hidden must be found as on a
+    beam without it.  Seeds ``seed + 1000 + i``; the mass and its place from their own
+    stream, the rest of each case drawn as :func:`draw` draws it."""
+    L = BEAM["length"]
+    beam_mass = BEAM["rho"] * BEAM["b"] * BEAM["h"] * L
+    cases, s = [], seed + 1000
+    for klass, count in KNOWN_PLAN:
+        for _ in range(count):
+            s += 1
+            rng = np.random.default_rng([s, 1])
+            mass = beam_mass * float(np.exp(rng.uniform(np.log(0.05), np.log(0.6))))
+            place = round(float(rng.uniform(0.1, 0.9)) * L, 4)
+            cases.append(draw(klass, s, known=(place, mass)))
+    return cases
 
 
 # -------------------------------------------------------------------------------------------
