@@ -267,3 +267,23 @@ def test_the_users_loop_takes_out_what_the_others_make_unnecessary():
     assert abs(final.effects[0].parameters["position"] - 0.19) < 0.02 * L
     assert last.verdict == "consistent" and last.not_needed == []
     assert row["verdicts"] == ["consistent", "consistent"]
+
+
+def test_a_known_effect_case_scores_what_the_loop_found_not_what_the_model_held():
+    """A case of ``bench_diagnosis.py --known`` (``truths.known_campaign``): the model file
+    holds a known spring to ground that the truth holds too, and a mass is hidden beside it.
+    The campaign's loop finds the mass where it is and ends ``consistent``; the score counts
+    what the loop added (the mass), not the known spring the model held from the start."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import bench_diagnosis
+
+    from . import truths
+
+    (case,) = [c for c in truths.known_campaign(2200) if c.name.endswith("-3220")]
+    assert [e["effect"] for e in case.model["effects"]] == ["point_spring"]
+    assert [h.klass for h in case.hidden] == ["mass"]
+    row = bench_diagnosis.run_case(case)
+    assert row["exit"] == 0 and row["added"] == ["point_mass"], row
+    assert [e["effect"] for e in row["final_effects"]] == ["point_mass"]
+    assert row["verdict_right"] and not row["false_alarm"]
+    assert row["position_error_pct"][0] < 2.0

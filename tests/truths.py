@@ -223,8 +223,10 @@ CLASS_SUPPORTS = {
 def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=False,
          law=None, known=None) -> Case:
     """One case of ``klass`` (a class of :data:`ANSWERS`, or "shear"), drawn from ``seed``.
-    ``known``: (position m, mass kg) of an attached mass in the truth and in the model
-    file (:func:`known_campaign`); the case's other draws are as without it."""
+    ``known``: an effect the truth and the model file both hold, ``{"effect":
+    "point_mass", "position": m, "mass": kg}`` or ``{"effect": "point_spring", "position":
+    m, "stiffness": N/m}`` (:func:`known_campaign`); the case's other draws are as without
+    it."""
     rng = np.random.default_rng(seed)
     L = BEAM["length"]
     if klass == "shear":
@@ -244,7 +246,9 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
         hidden.append(hid)
         each.append(ch)
 
-    given = [] if known is None else [{"point_masses": [tuple(known)]}]
+    given = [] if known is None else [
+        {"point_masses": [(known["position"], known["mass"])]} if known["effect"] ==
+        "point_mass" else {"point_springs": [(known["position"], known["stiffness"])]}]
 
     def truth_beam(parts):
         return ReferenceBeam(length=L, EI=EI, rho_a=rho_a, elements=800,
@@ -283,9 +287,9 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
     law_tag = "-" + hidden[0].law if hidden and hidden[0].law else ""
     model = model_dict(supports, elements)
     if known is not None:
-        model["effects"] = [{"effect": "point_mass", "position": float(known[0]),
-                             "mass": float(known[1])}]
-        group, law_tag = "known", f"-{klass}{law_tag}"
+        model["effects"] = [{k: (float(v) if k != "effect" else v) for k, v in known.items()}]
+        tag = "" if known["effect"] == "point_mass" else "spring-"
+        group, law_tag = "known", f"-{tag}{klass}{law_tag}"
     return Case(f"{group}{law_tag}-{name_support}-{seed}", group, model, x, freqs,
                 None if frequency_only else shapes, hidden, stated, factor,
                 in_family=all(hd.law in ("", "christides_barr") for hd in hidden)
@@ -441,27 +445,38 @@ def campaign(seed: int = 2100, subset: int | None = None) -> list[Case]:
     return cases[::subset] if subset else cases
 
 
-#: the known-mass cases (:func:`known_campaign`): (hidden class, how many)
+#: the known-effect cases (:func:`known_campaign`): (hidden class, how many), for each kind
+#: of known effect
 KNOWN_PLAN = [("crack", 4), ("zone", 2), ("mass", 2), ("spring", 2), ("none", 2)]
 
 
 def known_campaign(seed: int = 2100) -> list[Case]:
-    """Cases whose model file holds a known attached mass (in the truth too: a motor, a
-    sensor block), 5–60 % of the beam's mass (log-uniform) at 10–90 % of its length, and
-    one hidden effect of :data:`KNOWN_PLAN` beside it (or none): the mass is part of the
-    structure the user modelled, not a finding, and what is hidden must be found as on a
-    beam without it.  Seeds ``seed + 1000 + i``; the mass and its place from their own
-    stream, the rest of each case drawn as :func:`draw` draws it."""
+    """Cases whose model file holds a known effect (in the truth too) and one hidden effect
+    of :data:`KNOWN_PLAN` beside it (or none): the known effect is part of the structure
+    the user modelled, not a finding, and what is hidden must be found as on a beam without
+    it.  First an attached mass (a motor, a sensor block), 5–60 % of the beam's mass, then
+    a spring to ground (a prop the model holds), 1–30 times EI (π/L)³ (the campaign's
+    hidden springs are 0.5–3), both log-uniform at 10–90 % of the length.  Seeds ``seed +
+    1000 + i``; the known effect from its own stream, the rest of each case drawn as
+    :func:`draw` draws it."""
     L = BEAM["length"]
     beam_mass = BEAM["rho"] * BEAM["b"] * BEAM["h"] * L
+    EI = BEAM["E"] * BEAM["b"] * BEAM["h"] ** 3 / 12
     cases, s = [], seed + 1000
-    for klass, count in KNOWN_PLAN:
-        for _ in range(count):
-            s += 1
-            rng = np.random.default_rng([s, 1])
-            mass = beam_mass * float(np.exp(rng.uniform(np.log(0.05), np.log(0.6))))
-            place = round(float(rng.uniform(0.1, 0.9)) * L, 4)
-            cases.append(draw(klass, s, known=(place, mass)))
+    for known in ("point_mass", "point_spring"):
+        for klass, count in KNOWN_PLAN:
+            for _ in range(count):
+                s += 1
+                rng = np.random.default_rng([s, 1])
+                if known == "point_mass":
+                    size = {"mass": beam_mass * float(np.exp(rng.uniform(np.log(0.05),
+                                                                         np.log(0.6))))}
+                else:
+                    size = {"stiffness": EI * (np.pi / L) ** 3 * float(
+                        np.exp(rng.uniform(0.0, np.log(30.0))))}
+                place = round(float(rng.uniform(0.1, 0.9)) * L, 4)
+                cases.append(draw(klass, s, known={"effect": known, "position": place,
+                                                   **size}))
     return cases
 
 
