@@ -318,7 +318,7 @@ class Slot:
     start: dict
     variables: tuple
     added: bool
-    found: bool = True   # the effect it gives is fitted (added, or found before)
+    found: bool   # the effect it gives is fitted to data (added, or found before)
 
 
 def slots_for(model: Model, adding) -> list[Slot]:

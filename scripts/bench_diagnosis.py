@@ -163,13 +163,11 @@ def run_case(case) -> dict:
         row["remaining"] = getattr(result, "remaining", None)
         # present effects the last diagnosis says the others make unnecessary (step 9)
         row["not_needed"] = [n["effect"] for n in result.not_needed]
-        if all(flags):
-            _score(row, case, model, fit)
-        else:   # the effects the case's model was given (a known mass) are not findings
-            sigma = list(fit.sigma) if fit is not None else [{}] * len(flags)
-            _score(row, case, model, SimpleNamespace(sigma=[
-                s for s, new in zip(sigma, flags) if new]),
-                added=[e for e, new in zip(model.effects, flags) if new], live=True)
+        # what the loop added is scored, not what the case's model was given (a known mass)
+        sigma = list(fit.sigma) if fit is not None else [{}] * len(flags)
+        _score(row, case, model, SimpleNamespace(sigma=[s for s, new in zip(sigma, flags)
+                                                        if new]),
+               added=[e for e, new in zip(model.effects, flags) if new])
     except GfeInputError as exc:
         row["exit"] = 2
         row["error"] = str(exc)
@@ -299,11 +297,10 @@ def _no_local(case) -> bool:
     return all(h.klass in truths.GLOBAL for h in case.hidden)
 
 
-def _score(row, case, model, fit, added=None, live=False):
-    """Score a finished loop (``added``: the final model's effects the loop added; given
-    when rescoring stored rows, whose z are then kept, or, ``live``, when the case's model
-    held known effects)."""
-    rescoring = added is not None and not live
+def _score(row, case, model, fit, added=None, rescoring=False):
+    """Score a finished loop: ``added``, the final model's effects the loop added (None:
+    all of them), with ``fit.sigma`` theirs; ``rescoring`` stored rows, whose z are kept
+    where their final effects were stored without σ."""
     added = list(model.effects) if added is None else added
     sigmas = list(fit.sigma) if fit is not None else [{}] * len(added)
     used, positions, sizes, z = set(), [], [], []
@@ -574,7 +571,7 @@ def _rescore_row(row, case) -> None:
     added = [SimpleNamespace(name=e["effect"], parameters=e["parameters"])
              for e in row["final_effects"]]
     fit = SimpleNamespace(sigma=[e.get("uncertainty", {}) for e in row["final_effects"]])
-    _score(row, case, model, fit, added=added)
+    _score(row, case, model, fit, added=added, rescoring=True)
 
 
 #: the shares :func:`_form_sweep` tries (selection step 10's ``FORM_SHARE`` among them)
