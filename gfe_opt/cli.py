@@ -17,15 +17,14 @@ from pathlib import Path
 
 from .errors import GfeInputError, GfeSolverError
 from .names import BUILTIN_EFFECTS as EFFECTS
+from .names import DEFAULT_COMPARE_SHAPE_NOISE as DEFAULT_SHAPE_NOISE
 from .names import (
-    COMPARE_FIGURES,
     DEFAULT_FIT_SHAPE_NOISE,
     DEFAULT_FREQ_NOISE,
     DEFAULT_MAC_THRESHOLD,
     DIAGNOSIS_FIGURES,
     FRF_FORMS,
 )
-from .names import DEFAULT_COMPARE_SHAPE_NOISE as DEFAULT_SHAPE_NOISE
 from .outputs import check_distinct, check_output_folder, check_output_path
 
 # numerical modules are imported by the commands that use them: --version, --help and
@@ -239,22 +238,6 @@ def _figures(build, *args) -> dict:
 
 
 
-def _comparison_report(report, result, model, measured):
-    report.heading("Comparison")
-    report.paragraph(f"{model.name}: {model.kind}, {model.elements} elements; "
-                     f"{measured.n_modes} measured modes at {measured.n_sensors} sensors.")
-    report.table(["mode", "f_test [Hz]", "f_model [Hz]", "Δf %", "MAC"],
-                 [[p.test_mode, f"{p.test_hz:.2f}", f"{p.model_hz:.2f}",
-                   f"{p.error_pct:+.2f}", "—" if p.mac is None else f"{p.mac:.3f}"]
-                  for p in result.pairs])
-    mac = "" if result.mac_mean is None else f", mean MAC {result.mac_mean:.3f}"
-    report.paragraph(f"Frequency error {result.freq_error_rms_pct:.2f} % rms{mac}.")
-    report.paragraph("; ".join(result.notes))
-    for x, rel in result.failure_places():
-        report.paragraph(f"The model fails near x = {x:.3f} m "
-                         f"({100 * rel:.0f} % of the largest residual force).")
-
-
 def _inputs(args, frames: bool = False):
     """The model and measured files of a command (input errors before any solver loads);
     ``frames``: the command takes a plane frame too."""
@@ -266,120 +249,35 @@ def _inputs(args, frames: bool = False):
 
 
 def cmd_compare(args) -> int:
-    from .correlation import compare
-    from .text import format_comparison
+    from .structure import structure
 
-    if _is_frame(args.model):
-        return _compare_frame(args)
-    _check_outputs(args, COMPARE_FIGURES)
-    model, measured = _inputs(args)
-    result = compare(model, measured, mac_threshold=args.mac_threshold, noise=args.shape_noise)
+    model, measured = _inputs(args, frames=True)
+    shape = structure(model)
+    _check_outputs(args, shape.compare_figures)
+    result = shape.compare(measured, mac_threshold=args.mac_threshold, noise=args.shape_noise)
     if args.json:
         print(json.dumps(result.to_json(), indent=1))
     else:
-        print(f"{model.name}: {model.kind}, {model.elements} elements, "
-              f"{measured.n_modes} measured modes at {measured.n_sensors} sensors")
-        print(format_comparison(result, model.length))
+        print(shape.headline(measured))
+        print(shape.format_comparison(result))
     if args.plot or args.report:
-        from .report import compare_figures
-
-        _write_outputs(args, _figures(compare_figures, result, model),
-                       lambda r: _comparison_report(r, result, model, measured),
-                       f"gfe-opt compare: {model.name}")
-    return 0
-
-
-def _is_frame(path) -> bool:
-    """Whether a model file says ``kind = "frame"`` (a file that is not TOML is left to
-    the beam path, whose errors say why; a frame file with a bad field to the frame path,
-    whose error names that field)."""
-    import tomllib
-
-    from .inputs import read_text
-
-    try:
-        data = tomllib.loads(read_text(path, "model"))
-    except (GfeInputError, tomllib.TOMLDecodeError, RecursionError):
-        return False
-    return isinstance(data, dict) and data.get("kind") == "frame"
-
-
-def _compare_frame(args) -> int:
-    """``compare`` on a plane frame: pairs, MAC, frequency errors, the sensors where the
-    shapes differ most; figures of the modes and the residual drawn on the frame."""
-    from .frame_data import compare_frame, frame_figures, load_frame_measured
-    from .model import load_model
-    from .names import FRAME_COMPARE_FIGURES
-    from .text import format_frame_comparison
-
-    _check_outputs(args, FRAME_COMPARE_FIGURES)
-    model = load_model(args.model, frames=True)
-    measured = load_frame_measured(args.measured, model)
-    result = compare_frame(model, measured, mac_threshold=args.mac_threshold)
-    if args.json:
-        print(json.dumps(result.to_json(), indent=1))
-    else:
-        shapes = (f"at {len(measured.sensors)} sensors" if measured.shapes is not None
-                  else "(frequencies only)")
-        print(f"{model.name}: frame, {len(model.members)} members, {model.n_elements} "
-              f"elements, {measured.n_modes} measured modes {shapes}")
-        print(format_frame_comparison(result))
-    if args.plot or args.report:
-        def fill(report):
-            report.heading("Comparison")
-            report.preformatted(format_frame_comparison(result))
-
-        _write_outputs(args, _figures(frame_figures, result, model, measured), fill,
+        _write_outputs(args, _figures(shape.comparison_figures, result, measured),
+                       lambda r: shape.comparison_report(r, result, measured),
                        f"gfe-opt compare: {model.name}")
     return 0
 
 
 def cmd_modes(args) -> int:
-    import numpy as np
-
-    from .assembly import discretise
-    from .measured import make_measured, save_measured
-    from .modal import discretisation_modes, rigid_body_count
     from .model import load_model
+    from .structure import structure
 
     check_output_path(args.out, args.force, (args.model,), kind="modes")
     model = load_model(args.model, frames=True)
     if args.modes < 1:
         raise GfeInputError("--modes", None, f"must be >= 1, got {args.modes}")
-    if model.kind == "frame":
-        from .frame import write_frame_modes
-
-        written, sensors, rigid = write_frame_modes(model, args.modes, args.out,
-                                                    force=args.force, protect=(args.model,))
-        print(f"{written} modes of {model.name} ({len(model.members)} members, "
-              f"{model.n_elements} elements) at {sensors} sensors written to {args.out}")
-        if rigid:
-            print(f"note: {rigid} rigid-body mode{'s' if rigid > 1 else ''} (0 Hz) left out")
-        return 0
-    from .inputs import MAX_SENSORS
-
-    if len(model.nodes) > MAX_SENSORS + 2:  # a value at every node (supports may drop two)
-        raise GfeInputError("--out", str(args.out), f"would hold shapes at {len(model.nodes)} "
-                            f"nodes, above the {MAX_SENSORS} sensors a measured file may "
-                            "have: use a model of fewer elements for a measured file")
-    disc = discretise(model)
-    rigid = rigid_body_count(disc)
-    if args.modes + rigid > len(disc.free) - 1:
-        raise GfeInputError("--modes", None, f"the model has {len(disc.free) - 1 - rigid} "
-                            f"elastic modes at most, asked for {args.modes}")
-    modes = discretisation_modes(disc, args.modes + rigid)
-    elastic = modes.frequencies_hz > 0  # measured modes vibrate: rigid-body ones left out
-    per = model.dofs_per_node
-    shapes = modes.shapes[::per][:, elastic]  # translations at the nodes
-    keep = np.any(shapes != 0, axis=1)
-    save_measured(make_measured(model.nodes[keep], "w" if model.kind == "beam" else "u",
-                                modes.frequencies_hz[elastic], shapes[keep], model.name),
-                  args.out, force=args.force, protect=(args.model,))
-    print(f"{int(elastic.sum())} modes of {model.name} at {int(keep.sum())} nodes written to "
-          f"{args.out}")
-    if rigid:
-        print(f"note: {rigid} rigid-body mode{'s' if rigid > 1 else ''} (0 Hz) left out: a "
-              "test measures vibration")
+    for line in structure(model).write_modes(args.modes, args.out, force=args.force,
+                                             protect=(args.model,)):
+        print(line)
     return 0
 
 

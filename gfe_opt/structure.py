@@ -139,6 +139,96 @@ class Line:
 
         return realise(generic.discretisation, discretise(self.model))
 
+    # -- compare: pairs, MAC, where the model fails ------------------------------------
+    #: the figures ``compare --plot`` writes
+    @property
+    def compare_figures(self) -> tuple:
+        from .names import COMPARE_FIGURES
+
+        return COMPARE_FIGURES
+
+    def compare(self, measured, *, mac_threshold=None, noise=None):
+        """Paired modes, frequency errors, MAC and where the model fails
+        (:func:`~gfe_opt.correlation.compare`: the residual forces of the measured shapes
+        expanded on the model, regularised by the relative shape ``noise``)."""
+        from .correlation import DEFAULT_MAC_THRESHOLD, DEFAULT_SHAPE_NOISE, compare
+
+        return compare(self.model, measured,
+                       mac_threshold=DEFAULT_MAC_THRESHOLD if mac_threshold is None
+                       else mac_threshold,
+                       noise=DEFAULT_SHAPE_NOISE if noise is None else noise)
+
+    def headline(self, measured) -> str:
+        """The first line ``compare`` prints: the model and the test."""
+        model = self.model
+        return (f"{model.name}: {model.kind}, {model.elements} elements, "
+                f"{measured.n_modes} measured modes at {measured.n_sensors} sensors")
+
+    def format_comparison(self, result) -> str:
+        """The comparison as text (pairs, then where the model fails)."""
+        from .text import format_comparison
+
+        return format_comparison(result, self.model.length)
+
+    def comparison_figures(self, result, measured) -> dict:
+        """The figures of a comparison, by file name."""
+        from .report import compare_figures
+
+        return compare_figures(result, self.model)
+
+    def comparison_report(self, report, result, measured) -> None:
+        """The comparison's section of an HTML report."""
+        model = self.model
+        report.heading("Comparison")
+        report.paragraph(f"{model.name}: {model.kind}, {model.elements} elements; "
+                         f"{measured.n_modes} measured modes at {measured.n_sensors} "
+                         "sensors.")
+        report.table(["mode", "f_test [Hz]", "f_model [Hz]", "Δf %", "MAC"],
+                     [[p.test_mode, f"{p.test_hz:.2f}", f"{p.model_hz:.2f}",
+                       f"{p.error_pct:+.2f}", "—" if p.mac is None else f"{p.mac:.3f}"]
+                      for p in result.pairs])
+        mac = "" if result.mac_mean is None else f", mean MAC {result.mac_mean:.3f}"
+        report.paragraph(f"Frequency error {result.freq_error_rms_pct:.2f} % rms{mac}.")
+        report.paragraph("; ".join(result.notes))
+        for x, rel in result.failure_places():
+            report.paragraph(f"The model fails near x = {x:.3f} m "
+                             f"({100 * rel:.0f} % of the largest residual force).")
+
+    # -- modes: the model's modes written as a test ---------------------------------------
+    def write_modes(self, n_modes: int, out, *, force: bool = False, protect=()) -> list[str]:
+        """Write the model's ``n_modes`` lowest elastic modes to ``out`` as a measured file
+        (the translations at the nodes: a beam's w, a bar's u); returns the lines
+        ``gfe-opt modes`` prints."""
+        from .errors import GfeInputError
+        from .inputs import MAX_SENSORS
+        from .measured import make_measured, save_measured
+        from .modal import discretisation_modes, rigid_body_count
+
+        model = self.model
+        if len(model.nodes) > MAX_SENSORS + 2:  # a value at every node (supports may drop two)
+            raise GfeInputError("--out", str(out), f"would hold shapes at {len(model.nodes)} "
+                                f"nodes, above the {MAX_SENSORS} sensors a measured file may "
+                                "have: use a model of fewer elements for a measured file")
+        disc = discretise(model)
+        rigid = rigid_body_count(disc)
+        if n_modes + rigid > len(disc.free) - 1:
+            raise GfeInputError("--modes", None, f"the model has {len(disc.free) - 1 - rigid} "
+                                f"elastic modes at most, asked for {n_modes}")
+        modes = discretisation_modes(disc, n_modes + rigid)
+        elastic = modes.frequencies_hz > 0  # measured modes vibrate: rigid-body ones left out
+        per = model.dofs_per_node
+        shapes = modes.shapes[::per][:, elastic]  # translations at the nodes
+        keep = np.any(shapes != 0, axis=1)
+        save_measured(make_measured(model.nodes[keep], "w" if model.kind == "beam" else "u",
+                                    modes.frequencies_hz[elastic], shapes[keep], model.name),
+                      out, force=force, protect=protect)
+        lines = [f"{int(elastic.sum())} modes of {model.name} at {int(keep.sum())} nodes "
+                 f"written to {out}"]
+        if rigid:
+            lines.append(f"note: {rigid} rigid-body mode{'s' if rigid > 1 else ''} (0 Hz) left "
+                         "out: a test measures vibration")
+        return lines
+
     def check_repeats(self, effects, where: str) -> None:
         """At most one instance of a global effect."""
         from .model import check_repeats
@@ -226,6 +316,56 @@ class Frame(Line):
         from .realisation import realise_members
 
         return realise_members(generic.discretisation, discretise(self.model))
+
+    @property
+    def compare_figures(self) -> tuple:
+        from .names import FRAME_COMPARE_FIGURES
+
+        return FRAME_COMPARE_FIGURES
+
+    def compare(self, measured, *, mac_threshold=None, noise=None):
+        """Paired modes, frequency errors, MAC and each sensor's shape residual
+        (:func:`~gfe_opt.frame_data.compare_frame`; nothing is expanded, so ``noise``
+        does not enter)."""
+        from .frame_data import compare_frame
+
+        return compare_frame(self.model, measured, mac_threshold=mac_threshold)
+
+    def headline(self, measured) -> str:
+        model = self.model
+        shapes = (f"at {len(measured.sensors)} sensors" if measured.shapes is not None
+                  else "(frequencies only)")
+        return (f"{model.name}: frame, {len(model.members)} members, {model.n_elements} "
+                f"elements, {measured.n_modes} measured modes {shapes}")
+
+    def format_comparison(self, result) -> str:
+        from .text import format_frame_comparison
+
+        return format_frame_comparison(result)
+
+    def comparison_figures(self, result, measured) -> dict:
+        from .frame_data import frame_figures
+
+        return frame_figures(result, self.model, measured)
+
+    def comparison_report(self, report, result, measured) -> None:
+        report.heading("Comparison")
+        report.preformatted(self.format_comparison(result))
+
+    def write_modes(self, n_modes: int, out, *, force: bool = False, protect=()) -> list[str]:
+        """The frame's modes at its sensors' places (:func:`~gfe_opt.frame.write_frame_modes`:
+        x and y at the nodes and along the members)."""
+        from .frame import write_frame_modes
+
+        model = self.model
+        written, sensors, rigid = write_frame_modes(model, n_modes, out, force=force,
+                                                    protect=protect)
+        lines = [f"{written} modes of {model.name} ({len(model.members)} members, "
+                 f"{model.n_elements} elements) at {sensors} sensors written to {out}"]
+        if rigid:
+            lines.append(f"note: {rigid} rigid-body mode{'s' if rigid > 1 else ''} (0 Hz) left "
+                         "out")
+        return lines
 
     def check_repeats(self, effects, where: str) -> None:
         """One joint spring a member end, one axial load a member."""
