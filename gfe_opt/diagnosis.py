@@ -312,6 +312,10 @@ class Diagnosis:
     #: what the present effects do: {"effects": [its effects' JSON], "chi2_gain",
     #: "chi2_explained", "share"} (``diagnose --json``'s ``withheld``), else None
     withheld: dict | None = None
+    #: effects the user modelled whose re-estimate lies 3 σ or more from the value the
+    #: model gives: [{"effect", "index", "parameters": {key: {"given", "estimate",
+    #: "sigma"}}}] (``diagnose --json``'s ``moved``; the verdict reads them re-estimated)
+    moved: list = field(default_factory=list)
 
     @property
     def best(self) -> Fit | None:
@@ -383,6 +387,7 @@ class Diagnosis:
                 "replace": None if self.replace is None else dict(self.replace),
                 "not_needed": [jsonable(d) for d in self.not_needed],
                 "withheld": None if self.withheld is None else jsonable(self.withheld),
+                "moved": [jsonable(m) for m in self.moved],
                 "realisation": list(self.realisation),
                 "notes": [str(n) for n in self.notes],
                 "caveats": [c.to_json() for c in self.caveats]}
@@ -1072,6 +1077,16 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                shape_correlation(reference.model if reference else model, measured, noise, C))
     verdict = _verdict(ranked, ref_misfit, ref_params, noise, current, measured, model)
     swap = _swap(model, measured, noise, reference, names, sel)
+    if swap is not None and verdict == "effect_found":
+        finding = together if suggested and together is not None else ranked[0]
+        if sel.penalised(finding) < sel.penalised(swap[1]) and _form_of_present(
+                model, measured, noise, C, ref_misfit, finding) is None:
+            # an addition that keeps the present effect explains more for its parameters
+            # (and is not withheld by step 10: then the replacement stands, the held-out
+            # block 2370): the effect was on its edge only while the addition was missing
+            # (a known crack re-estimated to nothing beside a missing prop, back at its
+            # depth with it)
+            swap = None
     replace = None
     if swap is not None:
         # a present effect that ends on the edge of its range, better read as another
@@ -1129,13 +1144,18 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         notes += _ambiguities(ranked[0], alike, measured, noise, C, sel,
                               together if suggested and together is not None else None)
     notes += _present_mirrors(reference, measured, noise, C, sel)
-    notes += _known_moved(model, reference, baseline, ref_misfit)
+    moved = _known_moved(model, reference)
+    notes += [_moved_note(m, baseline, ref_misfit) for m in moved]
     if measured.frequency_only:
         notes.append(measured.without_shapes_note())
         if realise:
             notes.append("the generic-element update needs mode shapes: not run")
     notes += _noise_notes(estimate, verdict, measured)
-    not_needed = _not_needed(model, reference, without, sel) if drops else []
+    # backward elimination judges the effects that are to stay: with an effect missing they
+    # are re-estimated without it (a known crack read as nothing beside a missing prop was
+    # "not needed"); the next diagnosis, after the addition, judges them
+    not_needed = _not_needed(model, reference, without, sel) \
+        if drops and verdict != "effect_found" else []
     for d in not_needed:
         notes.append(f"the present {d['effect']} (effects[{d['index']}]) is not needed with the "
                      f"others: taking it out, the others re-estimated, raises χ² by "
@@ -1153,37 +1173,46 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                      nodal=nodal or [], generic_update=generic, profile_band=band,
                      notes=notes, remaining=remaining,
                      offered=offered if verdict == "unexplained" else [],
-                     replace=replace, not_needed=not_needed, withheld=withheld)
+                     replace=replace, not_needed=not_needed, withheld=withheld,
+                     moved=moved)
 
 
-def _known_moved(model, reference, baseline, ref_misfit) -> list[str]:
-    """A note for each effect the user modelled (not :attr:`~gfe_opt.model.Effect.found`)
-    whose re-estimate lies :data:`SIZE_SIGMAS` or more of its σ from the value the model
-    gives: the verdict reads the model with its effects re-estimated, and a known part
-    that the data move (a known 0.135 kg mass read as 0.208 kg beside a hidden 0.077 kg
-    one 3 cm away) is itself a difference between the model as it stands and the test."""
+def _known_moved(model, reference) -> list[dict]:
+    """The effects the user modelled (not :attr:`~gfe_opt.model.Effect.found`) whose
+    re-estimate lies :data:`SIZE_SIGMAS` or more of its σ from the value the model gives
+    (:attr:`Diagnosis.moved`): the verdict reads the model with its effects re-estimated,
+    and a known part that the data move (a known 0.135 kg mass read as 0.208 kg beside a
+    hidden 0.077 kg one 3 cm away) is itself a difference between the model as it stands
+    and the test."""
     if reference is None:
         return []
     out = []
     for i, (given, again) in enumerate(zip(model.effects, reference.effects)):
         if given.found:
             continue
-        moved = []
+        moved = {}
         for key, value in again.parameters.items():
             old, sigma = given.parameters.get(key), reference.sigma[i].get(key)
             if not isinstance(value, (int, float)) or not isinstance(old, (int, float)) \
                     or sigma is None or not np.isfinite(sigma) or sigma <= 0:
                 continue
             if abs(value - old) >= SIZE_SIGMAS * sigma:
-                moved.append(f"{key} {old:.4g} -> {value:.4g} ± {sigma:.2g}")
+                moved[key] = {"given": float(old), "estimate": float(value),
+                              "sigma": float(sigma)}
         if moved:
-            out.append(f"the model's {given.name} (effects[{i}]) is not as the data read it: "
-                       + ", ".join(moved) + f" (χ²/n {baseline.chi2_per_residual:.3g} as "
-                       f"modelled, {ref_misfit.chi2_per_residual:.3g} re-estimated; the "
-                       "verdict reads it re-estimated): a known part that is not as "
-                       "modelled, or another effect beside it that it takes up; gfe-opt "
-                       "update MODEL MEASURED writes it re-estimated")
+            out.append({"effect": given.name, "index": i, "parameters": moved})
     return out
+
+
+def _moved_note(moved: dict, baseline, ref_misfit) -> str:
+    """The note of one :func:`_known_moved` record, both values and both misfits."""
+    values = ", ".join(f"{key} {v['given']:.4g} -> {v['estimate']:.4g} ± {v['sigma']:.2g}"
+                       for key, v in moved["parameters"].items())
+    return (f"the model's {moved['effect']} (effects[{moved['index']}]) is not as the data "
+            f"read it: {values} (χ²/n {baseline.chi2_per_residual:.3g} as modelled, "
+            f"{ref_misfit.chi2_per_residual:.3g} re-estimated; the verdict reads it "
+            "re-estimated): a known part that is not as modelled, or another effect beside "
+            "it that it takes up; gfe-opt update MODEL MEASURED writes it re-estimated")
 
 
 #: how the notes that recommend adding an effect end (a profile that explains the rest, a
@@ -1266,7 +1295,9 @@ def _swap(model, measured, noise, reference, names, sel):
     the edge of its range (:func:`_on_edge`), has the lower information criterion (the
     others re-estimated with it), or None.  An effect added early can stand in for one it
     cannot be (a heavy zone at its largest mass ratio for a point mass, before the shear of
-    a deep beam was added): the loop otherwise never looks at it again."""
+    a deep beam was added): the loop otherwise never looks at it again.  :func:`diagnose`
+    keeps the replacement only when it ranks above the addition it would otherwise
+    suggest (the information criterion of :meth:`Selection.penalised`)."""
     if reference is None or not reference.success:
         return None
     best = None

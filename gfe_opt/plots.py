@@ -19,6 +19,13 @@ def _figure(width=7.0, height=3.6):
     return Figure(figsize=(width, height), layout="constrained")
 
 
+def _wrapped(title: str, width: int = 90) -> str:
+    """A long title (a verdict with its condition) on lines that fit a figure's width."""
+    import textwrap
+
+    return "\n".join(textwrap.wrap(title, width)) or title
+
+
 def save(fig, path) -> Path:
     """Write ``fig`` as a PNG (150 dpi), atomically, and return the path."""
     from .outputs import atomic_write
@@ -297,7 +304,7 @@ def candidate_errors(fits, baseline_pct, together=None, verdict=None, *, length=
                  + "best first; green: the effect found, pale green: significant but not "
                  "the answer", fontsize=8)
     if verdict:
-        fig.suptitle(f"verdict: {verdict}", fontsize=10, fontweight="bold")
+        fig.suptitle(_wrapped(f"verdict: {verdict}"), fontsize=10, fontweight="bold")
     ax.legend(fontsize=8)
     if sketch is not None:
         structure_sketch(sketch, length, supports, findings=findings, elsewhere=elsewhere)
@@ -666,5 +673,5 @@ def frame_findings(members, marks, failing, title, caveats=(), elsewhere=()):
     if failing or elsewhere:
         ax.legend(fontsize=7, loc="upper right", bbox_to_anchor=(1.0, 1.12), frameon=False)
     ax.margins(0.12)
-    ax.set_title(title, fontsize=10, fontweight="bold", loc="left")
+    ax.set_title(_wrapped(title), fontsize=10, fontweight="bold", loc="left")
     return fig

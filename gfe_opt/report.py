@@ -53,11 +53,11 @@ def elsewhere(diagnosis) -> list:
 
 def verdict_title(diagnosis) -> str:
     """``crack missing``, else the verdict in the words the text prints."""
-    from .text import VERDICT_WORDS
+    from .text import verdict_words
 
     if diagnosis.verdict == "effect_found":
         return " + ".join(diagnosis.suggested) + " missing"
-    return VERDICT_WORDS[diagnosis.verdict]
+    return verdict_words(diagnosis)
 
 
 def withheld_title(diagnosis) -> str | None:

@@ -21,6 +21,20 @@ VERDICT_WORDS = {
 }
 
 
+def verdict_words(result) -> str:
+    """The verdict in words; ``consistent`` says so when it holds only with an effect the
+    user modelled re-estimated (:attr:`~gfe_opt.diagnosis.Diagnosis.moved`): the model as
+    given does not agree."""
+    words = VERDICT_WORDS[result.verdict]
+    moved = getattr(result, "moved", None)
+    if result.verdict != "consistent" or not moved:
+        return words
+    which = " and ".join(f"{m['effect']} (effects[{m['index']}])" for m in moved)
+    return (f"the model agrees with the test within the noise once its {which} "
+            f"{'is' if len(moved) == 1 else 'are'} re-estimated (see the note); as given "
+            f"it does not (χ²/n {_ratio(result.baseline.chi2_per_residual)}); nothing to add")
+
+
 def withheld_words(withheld: dict) -> str:
     """``not named: a further stiffness_profile, 0.44 % of what the present effects
     explain`` (a diagnosis's ``withheld``; the text and the candidates figure)."""
@@ -140,7 +154,7 @@ def format_diagnosis(result, model) -> str:
     if result.failed:
         lines.append("failed fits, not ranked: " + "; ".join(
             f"{f.name} ({'; '.join(f.notes)})" for f in result.failed))
-    lines += ["", "verdict: " + VERDICT_WORDS[result.verdict]]
+    lines += ["", "verdict: " + verdict_words(result)]
     best = result.best
     if best is not None:
         lines.append(f"  {best.describe()}")

@@ -5,9 +5,9 @@ the package did not build, scored.
     python scripts/bench_diagnosis.py --known [--seed S] [--json out.json]
 
 ``--known`` runs another list instead (``truths.known_campaign``): the model file holds a
-known effect (an attached mass, a spring to ground), in the truth too, and one hidden
-effect (or none) is to be found beside it; the known effect is not a finding and is not
-scored as one.
+known effect (an attached mass, a spring to ground, a crack found before), in the truth
+too, and one hidden effect (or none) is to be found beside it; the known effect is not a
+finding and is not scored as one.
 
 Cases come from ``tests/truths.py`` (a fixed, seeded list: every hidden class alone, pairs,
 every support, other crack laws, smooth zones, tapers, deep beams, frequency-only sets,
@@ -42,7 +42,11 @@ A case is scored:
   effect that fits as well, ``alike``; the finding at another place, ``mirror``,
   ``places``, or with other parameters, ``equivalent``): the tool named the truth as what
   the data cannot tell from its finding; or the effect was found beyond the tolerance but
-  within twice the σ the tool gave its position. A case neither right nor said whose last verdict
+  within twice the σ the tool gave its position; or (``moved``) the last diagnosis says an
+  effect the user modelled, of a right name, is not as modelled (its ``moved``: 3 σ or
+  more from its given value; the verdict's words then say the model as given does not
+  agree) and it lies within the place tolerance of the hidden one: a hidden crack 3.6 mm
+  from a known one read as that crack, deeper. A case neither right nor said whose last verdict
   claims something (``consistent`` or ``effect_found``) is **confidently wrong**, the worst
   thing the tool can print; ``unexplained`` is not.
 
@@ -160,6 +164,10 @@ def run_case(case) -> dict:
         row["first_candidates"] = _candidates_of(result)
         model, fit, result, flags = follow(model, measured, noise, result, row)
         row["final_chi2_per_residual"] = result.current.chi2_per_residual
+        # the known effects the last diagnosis says are not as modelled, where it reads them
+        row["moved"] = [{"effect": m["effect"], "index": m["index"],
+                         "position": result.reference.effects[m["index"]].parameters.get(
+                             "position")} for m in result.moved]
         row["remaining"] = getattr(result, "remaining", None)
         # present effects the last diagnosis says the others make unnecessary (step 9)
         row["not_needed"] = [n["effect"] for n in result.not_needed]
@@ -378,7 +386,7 @@ def _score(row, case, model, fit, added=None, rescoring=False):
         right = True   # the data cannot show it: "consistent" with nothing added is right
     if rescoring and not all("uncertainty" in e for e in row.get("final_effects", [])):
         z = row.get("z", [])   # rows stored without the σ of their fit
-    said = _said(required, row.get("caveats"), model, added, sigmas) \
+    said = _said(required, row.get("caveats"), model, added, sigmas, row.get("moved", [])) \
         if not right and required else None
     # a row stored without the loop's caveats (before stop 55) cannot tell: None
     row.update(said=said, confident_wrong=None if "caveats" not in row else (
@@ -395,14 +403,17 @@ def _score(row, case, model, fit, added=None, rescoring=False):
                    for i, e in enumerate(added)])
 
 
-def _said(missed, caveats, model, added, sigmas) -> str | None:
+def _said(missed, caveats, model, added, sigmas, moved=()) -> str | None:
     """How the loop named every hidden effect in ``missed`` (pairs of the hidden effect and
     the nearest added effect of a right name, its index and position error, or None): by
     the caveats (``caveats``: their JSON) as fitting as well as what it found, ``"alike"``
     (another effect) when every one was named by that kind alone, ``"place"`` (a mirror
     place, other places or parameters) otherwise; or found beyond the tolerance but within
-    twice the σ it gave its position, ``"uncertainty"`` when that holds for every one; None
-    when one of them was named by none (or the row has no caveats recorded)."""
+    twice the σ it gave its position, ``"uncertainty"`` when that holds for every one; a
+    known effect of a right name the last diagnosis says moved (``moved``: the row's
+    records, with where it reads them) within the tolerance of it, ``"moved"`` when that
+    holds for every one; None when one of them was named by none (or the row has no
+    caveats recorded)."""
     if caveats is None:
         return None
     kinds = set()
@@ -417,6 +428,11 @@ def _said(missed, caveats, model, added, sigmas) -> str | None:
                     and abs(x - hid.position) <= 2.0 * sigma:
                 kinds.add("uncertainty")
                 continue
+        if placed and any(m["effect"] in names and m.get("position") is not None
+                          and abs(m["position"] - hid.position)
+                          <= POSITION_TOLERANCE * model.length for m in moved):
+            kinds.add("moved")
+            continue
         found = {c["kind"] for c in caveats if c["kind"] in SAID_KINDS
                  for effects in c["alternatives"] for e in effects
                  if e["effect"] in names and (not placed or abs(
@@ -425,7 +441,7 @@ def _said(missed, caveats, model, added, sigmas) -> str | None:
         if not found:
             return None
         kinds |= found
-    return next(iter(kinds)) if kinds in ({"alike"}, {"uncertainty"}) else "place"
+    return next(iter(kinds)) if kinds in ({"alike"}, {"uncertainty"}, {"moved"}) else "place"
 
 
 def scorecard(rows) -> dict:
@@ -659,7 +675,7 @@ def main(argv=None) -> int:
     parser.add_argument("--json", type=Path, help="also write the scorecard here")
     parser.add_argument("--cases", nargs="*", help="only cases whose name contains these")
     parser.add_argument("--known", action="store_true",
-                        help="the cases whose model holds a known mass or spring "
+                        help="the cases whose model holds a known mass, spring or crack "
                         "(truths.known_campaign) instead of the campaign's")
     parser.add_argument("--rescore", type=Path,
                         help="score the loops stored in this --json file again (no runs)")

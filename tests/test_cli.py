@@ -112,7 +112,7 @@ def test_diagnose_json_contract(files, capsys):
     assert set(data) == {"verdict", "baseline", "noise", "effects", "failed", "skipped",
                          "indistinguishable", "suggested", "together", "realisation",
                          "notes", "remaining", "offered", "replace", "not_needed", "add",
-                         "caveats", "withheld"}
+                         "caveats", "withheld", "moved"}
     assert data["add"] == data["suggested"]   # on a beam the names themselves
     # each caveat is one of the notes, with its kind and the effect sets that fit as well
     assert all(c["note"] in data["notes"] and set(c) == {"kind", "note", "alternatives", "present"}
@@ -121,6 +121,7 @@ def test_diagnose_json_contract(files, capsys):
     assert data["replace"] is None   # the model holds no effect to replace
     assert data["not_needed"] == []  # nor one to take out
     assert data["withheld"] is None  # nor one whose form a further effect might be
+    assert data["moved"] == []       # nor one the user modelled that the data move
     assert data["together"] is None
     assert data["verdict"] == "effect_found"
     # 4 noisy modes of a Christides-Barr crack: the library's crack brings them to the noise

@@ -10,6 +10,8 @@ import pytest
 from gfe_opt.diagnosis import diagnose, update
 from gfe_opt.measured import make_measured
 from gfe_opt.model import Effect
+from gfe_opt.report import verdict_title
+from gfe_opt.text import format_diagnosis
 
 from .conftest import make_model
 from .reference import ReferenceBeam, add_noise, christides_barr, interior, timoshenko_ss
@@ -182,10 +184,13 @@ def test_a_crack_beside_a_heavy_mass_the_user_modelled_is_named():
     assert d.suggested == ["crack"]
     assert abs(d.best.parameters["position"] - 0.15) < 0.02 * L
     assert abs(d.best.parameters["depth_ratio"] - 0.2) < 0.03
-    assert not [n for n in d.notes if "is not as the data read it" in n]
+    assert not [n for n in d.notes if "is not as the data read it" in n] and d.moved == []
     cracked = update(known, measured, ["crack"], **NOISE).model
     assert [e.found for e in cracked.effects] == [False, True]
-    assert diagnose(cracked, measured, **NOISE).verdict == "consistent"
+    last = diagnose(cracked, measured, **NOISE)
+    assert last.verdict == "consistent" and last.moved == []
+    assert "verdict: the model agrees with the test within the noise; nothing to add" in \
+        format_diagnosis(last, cracked)
     fitted = known.with_effects([replace(e, found=True) for e in known.effects])
     withheld = diagnose(fitted, measured, **NOISE)
     assert withheld.verdict == "unexplained"
@@ -205,9 +210,50 @@ def test_a_known_mass_that_is_not_as_modelled_is_said():
     (note,) = [n for n in d.notes if "is not as the data read it" in n]
     assert "point_mass (effects[0])" in note and "mass 0.2 -> 0.3" in note
     assert "gfe-opt update MODEL MEASURED writes it re-estimated" in note
+    # the JSON says which, and the verdict's words that the model as given does not agree
+    (moved,) = d.to_json()["moved"]
+    assert moved["effect"] == "point_mass" and moved["index"] == 0
+    mass = moved["parameters"]["mass"]
+    assert mass["given"] == 0.2 and abs(mass["estimate"] / 0.3 - 1) < 0.02
+    assert abs(mass["estimate"] - 0.2) >= 3 * mass["sigma"]
+    assert set(moved["parameters"]) <= {"mass", "position"}
+    words = format_diagnosis(d, known)
+    assert "agrees with the test within the noise once its point_mass (effects[0]) is " \
+           "re-estimated" in words and "as given it does not" in words
+    assert verdict_title(d) in words
     again = update(known, measured, [], **NOISE).model
     assert abs(again.effects[0].parameters["mass"] / 0.3 - 1) < 0.02
     assert again.effects[0].found is False   # re-estimated, still the user's known mass
+
+
+def test_a_known_crack_pushed_to_nothing_by_a_missing_prop_is_kept_not_replaced():
+    """The model file holds a crack found at an earlier inspection (0.15 m, a/d 0.35, as
+    in the structure: the reference beam's Christides–Barr EI(x)); a prop, a spring of 3e6
+    N/m to ground at 0.20 m, is missing.  Re-estimated without the prop the crack goes to
+    nothing (the edge of its depth's range): the diagnosis must not read that as a crack
+    better replaced by a spring (the spring then fitted 3 % of the length off) nor call the
+    crack not needed; the prop added beside the crack ranks first.  Added, the crack is
+    back at its place and depth, still the user's, and the beam agrees."""
+    from .reference import christides_barr
+
+    measured = reference_data(rigidity=christides_barr(0.15, 0.35),
+                              point_springs=[(0.20, 3e6)])
+    known = make_model().with_effects([Effect("crack", {"position": 0.15, "depth_ratio": 0.35})])
+    d = diagnose(known, measured, **NOISE)
+    assert d.reference.effects[0].parameters["depth_ratio"] < 0.05   # on its edge alone
+    assert d.verdict == "effect_found" and d.suggested == ["point_spring"]
+    assert d.replace is None and d.not_needed == []
+    assert not any("ends on the edge of its range" in n or "not needed" in n
+                   for n in d.notes)
+    spring = d.best.effects[-1].parameters
+    assert abs(spring["position"] - 0.20) < 0.005 * L
+    assert abs(spring["stiffness"] / 3e6 - 1) < 0.03
+    after = update(known, measured, ["point_spring"], **NOISE).model
+    crack, added = after.effects
+    assert crack.name == "crack" and crack.found is False and added.found is True
+    assert abs(crack.parameters["position"] - 0.15) < 0.01 * L
+    assert abs(crack.parameters["depth_ratio"] - 0.35) < 0.03
+    assert diagnose(after, measured, **NOISE).verdict == "consistent"
 
 
 def test_a_model_file_keeps_which_effects_were_found(tmp_path):

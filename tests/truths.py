@@ -224,9 +224,9 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
          law=None, known=None) -> Case:
     """One case of ``klass`` (a class of :data:`ANSWERS`, or "shear"), drawn from ``seed``.
     ``known``: an effect the truth and the model file both hold, ``{"effect":
-    "point_mass", "position": m, "mass": kg}`` or ``{"effect": "point_spring", "position":
-    m, "stiffness": N/m}`` (:func:`known_campaign`); the case's other draws are as without
-    it."""
+    "point_mass", "position": m, "mass": kg}``, ``{"effect": "point_spring", "position":
+    m, "stiffness": N/m}`` or ``{"effect": "crack", "position": m, "depth_ratio": a/d}``
+    (:func:`known_campaign`); the case's other draws are as without it."""
     rng = np.random.default_rng(seed)
     L = BEAM["length"]
     if klass == "shear":
@@ -246,9 +246,7 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
         hidden.append(hid)
         each.append(ch)
 
-    given = [] if known is None else [
-        {"point_masses": [(known["position"], known["mass"])]} if known["effect"] ==
-        "point_mass" else {"point_springs": [(known["position"], known["stiffness"])]}]
+    given = [] if known is None else [_known_part(known, h)]
 
     def truth_beam(parts):
         return ReferenceBeam(length=L, EI=EI, rho_a=rho_a, elements=800,
@@ -288,12 +286,23 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
     model = model_dict(supports, elements)
     if known is not None:
         model["effects"] = [{k: (float(v) if k != "effect" else v) for k, v in known.items()}]
-        tag = "" if known["effect"] == "point_mass" else "spring-"
+        tag = {"point_mass": "", "point_spring": "spring-", "crack": "crack-"}[known["effect"]]
         group, law_tag = "known", f"-{tag}{klass}{law_tag}"
     return Case(f"{group}{law_tag}-{name_support}-{seed}", group, model, x, freqs,
                 None if frequency_only else shapes, hidden, stated, factor,
                 in_family=all(hd.law in ("", "christides_barr") for hd in hidden)
                 and klass not in ("taper",), signal=signal, marginal=marginal)
+
+
+def _known_part(known, h) -> dict:
+    """The ReferenceBeam keywords of a known effect: a mass or a spring at its place, or a
+    crack as the Christides–Barr decay of EI(x) written in the tests' own code (the
+    package's ``crack`` the model file names is built by its own code)."""
+    if known["effect"] == "point_mass":
+        return {"point_masses": [(known["position"], known["mass"])]}
+    if known["effect"] == "point_spring":
+        return {"point_springs": [(known["position"], known["stiffness"])]}
+    return {"rigidity": christides_barr(known["position"], known["depth_ratio"], depth=h)}
 
 
 def _merge(supports, parts) -> dict:
@@ -448,6 +457,9 @@ def campaign(seed: int = 2100, subset: int | None = None) -> list[Case]:
 #: the known-effect cases (:func:`known_campaign`): (hidden class, how many), for each kind
 #: of known effect
 KNOWN_PLAN = [("crack", 4), ("zone", 2), ("mass", 2), ("spring", 2), ("none", 2)]
+#: the known effects, in this order (each a :data:`KNOWN_PLAN` of cases; a kind added later
+#: comes last, so the earlier cases keep their seeds)
+KNOWN_KINDS = ("point_mass", "point_spring", "crack")
 
 
 def known_campaign(seed: int = 2100) -> list[Case]:
@@ -456,14 +468,17 @@ def known_campaign(seed: int = 2100) -> list[Case]:
     the user modelled, not a finding, and what is hidden must be found as on a beam without
     it.  First an attached mass (a motor, a sensor block), 5–60 % of the beam's mass, then
     a spring to ground (a prop the model holds), 1–30 times EI (π/L)³ (the campaign's
-    hidden springs are 0.5–3), both log-uniform at 10–90 % of the length.  Seeds ``seed +
+    hidden springs are 0.5–3), both log-uniform, then a crack found at an earlier
+    inspection and written into the file by hand (a/d uniform 0.2–0.5; in the truth the
+    Christides–Barr decay of EI(x) in the tests' own code), each at 10–90 % of the
+    length.  Seeds ``seed +
     1000 + i``; the known effect from its own stream, the rest of each case drawn as
     :func:`draw` draws it."""
     L = BEAM["length"]
     beam_mass = BEAM["rho"] * BEAM["b"] * BEAM["h"] * L
     EI = BEAM["E"] * BEAM["b"] * BEAM["h"] ** 3 / 12
     cases, s = [], seed + 1000
-    for known in ("point_mass", "point_spring"):
+    for known in KNOWN_KINDS:
         for klass, count in KNOWN_PLAN:
             for _ in range(count):
                 s += 1
@@ -471,6 +486,8 @@ def known_campaign(seed: int = 2100) -> list[Case]:
                 if known == "point_mass":
                     size = {"mass": beam_mass * float(np.exp(rng.uniform(np.log(0.05),
                                                                          np.log(0.6))))}
+                elif known == "crack":
+                    size = {"depth_ratio": float(rng.uniform(0.2, 0.5))}
                 else:
                     size = {"stiffness": EI * (np.pi / L) ** 3 * float(
                         np.exp(rng.uniform(0.0, np.log(30.0))))}
