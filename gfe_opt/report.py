@@ -73,24 +73,16 @@ def diagnosis_figures(diagnosis, model) -> dict:
     """Candidate errors; with the generic update: its stiffness profile against the noise
     band and what the effect found would show, the structure with the located place and
     the fitted effects, the nodal equation coefficients and (for a crack) the identified
-    Q_i against Christides–Barr Q(x)."""
-    found = findings(diagnosis, model)
-    if model.kind == "frame":   # the effects on the frame; the generic update per member
-        from .frame_data import frame_diagnosis_figures
+    Q_i against Christides–Barr Q(x); drawn along the line or on the frame
+    (:meth:`~gfe_opt.structure.Line.diagnosis_figures`)."""
+    from .structure import structure
 
-        figs = {"candidates.png": plots.candidate_errors(
-            diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
-            verdict=verdict_title(diagnosis), note=withheld_title(diagnosis))} \
-            if diagnosis.fits else {}
-        figs.update(frame_diagnosis_figures(diagnosis, model, verdict_title(diagnosis),
-                                            found))
-        if diagnosis.profile_band is not None:
-            best = diagnosis.best
-            figs["stiffness_change.png"] = plots.frame_profiles(
-                diagnosis.profile_band, label=best.name if best else None)
-        if diagnosis.nodal:
-            figs["nodal_equations.png"] = plots.frame_nodal_coefficients(diagnosis.nodal)
-        return figs
+    return structure(model).diagnosis_figures(diagnosis)
+
+
+def line_diagnosis_figures(diagnosis, model) -> dict:
+    """:func:`diagnosis_figures` of a beam or bar: along x."""
+    found = findings(diagnosis, model)
     figs = {"candidates.png": plots.candidate_errors(
         diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
         verdict=verdict_title(diagnosis), length=model.length, supports=model.supports,
@@ -108,6 +100,26 @@ def diagnosis_figures(diagnosis, model) -> dict:
     if diagnosis.nodal:
         figs["nodal_equations.png"] = plots.nodal_coefficients(
             diagnosis.nodal, model.bending_rigidity, model.length)
+    return figs
+
+
+def frame_diagnosis_figures(diagnosis, model) -> dict:
+    """:func:`diagnosis_figures` of a frame: the effects on the frame, the generic update
+    member by member."""
+    from .frame_data import frame_diagnosis_figures as on_frame
+
+    figs = {"candidates.png": plots.candidate_errors(
+        diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
+        verdict=verdict_title(diagnosis), note=withheld_title(diagnosis))} \
+        if diagnosis.fits else {}
+    figs.update(on_frame(diagnosis, model, verdict_title(diagnosis),
+                         findings(diagnosis, model)))
+    if diagnosis.profile_band is not None:
+        best = diagnosis.best
+        figs["stiffness_change.png"] = plots.frame_profiles(
+            diagnosis.profile_band, label=best.name if best else None)
+    if diagnosis.nodal:
+        figs["nodal_equations.png"] = plots.frame_nodal_coefficients(diagnosis.nodal)
     return figs
 
 

@@ -194,6 +194,12 @@ class Line:
             report.paragraph(f"The model fails near x = {x:.3f} m "
                              f"({100 * rel:.0f} % of the largest residual force).")
 
+    def diagnosis_figures(self, diagnosis) -> dict:
+        """The figures of a diagnosis, by file name, drawn along the line."""
+        from .report import line_diagnosis_figures
+
+        return line_diagnosis_figures(diagnosis, self.model)
+
     # -- modes: the model's modes written as a test ---------------------------------------
     def write_modes(self, n_modes: int, out, *, force: bool = False, protect=()) -> list[str]:
         """Write the model's ``n_modes`` lowest elastic modes to ``out`` as a measured file
@@ -351,6 +357,12 @@ class Frame(Line):
     def comparison_report(self, report, result, measured) -> None:
         report.heading("Comparison")
         report.preformatted(self.format_comparison(result))
+
+    def diagnosis_figures(self, diagnosis) -> dict:
+        """The figures of a diagnosis, drawn on the frame."""
+        from .report import frame_diagnosis_figures
+
+        return frame_diagnosis_figures(diagnosis, self.model)
 
     def write_modes(self, n_modes: int, out, *, force: bool = False, protect=()) -> list[str]:
         """The frame's modes at its sensors' places (:func:`~gfe_opt.frame.write_frame_modes`:
