@@ -960,9 +960,11 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                     and not profile.failed and sel.better(profile, pair):
                 pair = None   # a free profile explains significantly more than the pair
             if pair is not None:
-                notes.append(f"{first.name} with a further {pair.name} brings the misfit to the "
-                             f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}; frequency error "
-                             f"{pair.misfit.freq_error_rms_pct:.3g} %): add them together")
+                notes.append(Recommendation(
+                    f"{first.name} with a further {pair.name} brings the misfit to the "
+                    f"noise (χ²/n {pair.misfit.chi2_per_residual:.3g}; frequency error "
+                    f"{pair.misfit.freq_error_rms_pct:.3g} %): add them together",
+                    (first.name, pair.name), pair=True))
                 suggested, together = [first.name, pair.name], pair
                 notes += equivalent_notes(pair, measured) + _traded_notes(pair)
                 if profile is not None:
@@ -970,8 +972,9 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                     profile.significant = False  # named effects win where they explain
             elif profile is not None and profile.significant and explains(profile) \
                     and not rivalled:
-                notes.append(f"{best.name} explains part of the difference; the "
-                             f"{profile.name} explains it to the noise")
+                notes.append(Recommendation(f"{best.name} explains part of the difference; "
+                                            f"the {profile.name} explains it to the noise",
+                                            (profile.name,)))
                 best.significant = False
             elif profile is not None and profile.significant and sel.better(profile, best) \
                     and not rivalled and (tied := _tied_pair(tried, profile, sel)) is not None:
@@ -981,10 +984,11 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                 # continuum's own stiffness asks for)
                 first_name = tied.effects[tied.added - 1].name
                 suggested, together = [first_name, tied.name], tied
-                notes.append(f"{first_name} with a further {tied.name} explains as much as a "
-                             f"free {profile.name} (χ²/n "
-                             f"{tied.misfit.chi2_per_residual:.3g} against "
-                             f"{profile.misfit.chi2_per_residual:.3g}): add them together")
+                notes.append(Recommendation(
+                    f"{first_name} with a further {tied.name} explains as much as a free "
+                    f"{profile.name} (χ²/n {tied.misfit.chi2_per_residual:.3g} against "
+                    f"{profile.misfit.chi2_per_residual:.3g}): add them together",
+                    (first_name, tied.name), pair=True))
                 notes += equivalent_notes(tied, measured) + _traded_notes(tied)
                 profile.significant = False
             elif profile is not None and profile.significant and sel.better(profile, best) \
@@ -1053,7 +1057,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
         undecided = _undetermined(together, model)
         if undecided:  # the pair is not determined: the first effect alone may still be
             said = set(equivalent_notes(together, measured))
-            notes = [n for n in notes if n not in said and not n.endswith("add them together")]
+            notes = [n for n in notes if n not in said
+                     and not (isinstance(n, Recommendation) and n.pair)]
             notes.append(_undecided_note(together, undecided, measured, len(model.effects),
                                          "the pair is not suggested"))
             suggested, together = [], None
@@ -1118,8 +1123,8 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             # why it is not named ("the stiffness_profile explains it to the noise" just
             # before "... not named" read as a contradiction)
             names = {e["effect"] for e in withheld["effects"]}
-            notes = [n for n in notes if not (n.endswith(RECOMMENDING) and any(
-                name in n for name in names))]
+            notes = [n for n in notes if not (isinstance(n, Recommendation)
+                                              and names.intersection(n.effects))]
             notes.append(withheld.pop("note"))
             for f in ranked:
                 f.significant = False
@@ -1215,9 +1220,19 @@ def _moved_note(moved: dict, baseline, ref_misfit) -> str:
             "it that it takes up; gfe-opt update MODEL MEASURED writes it re-estimated")
 
 
-#: how the notes that recommend adding an effect end (a profile that explains the rest, a
-#: pair to add together): withdrawn when selection step 10 withholds that effect
-RECOMMENDING = ("explains it to the noise", "add them together")
+class Recommendation(str):
+    """A note that recommends adding ``effects`` (a profile that explains the rest, or a
+    pair to add together, ``pair``): tagged where it is made, so that a later step that
+    does not suggest them takes it back by what it recommends, not by its words (an
+    undetermined pair; selection step 10 withholding the effect)."""
+
+    def __new__(cls, text: str, effects: tuple, pair: bool = False):
+        note = super().__new__(cls, text)
+        note.effects, note.pair = tuple(effects), pair
+        return note
+
+    def __reduce__(self):
+        return Recommendation, (str(self), self.effects, self.pair)
 
 
 def _form_of_present(model, measured, noise, C, ref_misfit, finding) -> dict | None:

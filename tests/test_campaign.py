@@ -76,8 +76,11 @@ def test_what_another_crack_law_leaves_is_not_named_as_a_further_effect():
                f"{' '.join('--add ' + n for n in names)})" in n for n in last.notes)
     # and no earlier note still recommends it ("the stiffness_profile explains it to the
     # noise" stood before the note that withholds it)
-    assert not [n for n in last.notes if "explains it to the noise" in n
-                or n.endswith("add them together")], last.notes
+    from gfe_opt.diagnosis import Recommendation
+
+    assert not [n for n in last.notes if isinstance(n, Recommendation)
+                or "explains it to the noise" in n or n.endswith("add them together")], \
+        last.notes
     # the text and the figure say the same as the JSON: the verdict, what is not named
     # and its share
     from gfe_opt.report import diagnosis_figures
