@@ -1312,7 +1312,7 @@ def _swap(model, measured, noise, reference, names, sel):
     cannot be (a heavy zone at its largest mass ratio for a point mass, before the shear of
     a deep beam was added): the loop otherwise never looks at it again.  :func:`diagnose`
     keeps the replacement only when it ranks above the addition it would otherwise
-    suggest (the information criterion of :meth:`Selection.penalised`)."""
+    suggest (the information criterion of :meth:`_Selection.penalised`)."""
     if reference is None or not reference.success:
         return None
     best = None

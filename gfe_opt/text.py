@@ -23,16 +23,16 @@ VERDICT_WORDS = {
 
 def verdict_words(result) -> str:
     """The verdict in words; ``consistent`` says so when it holds only with an effect the
-    user modelled re-estimated (:attr:`~gfe_opt.diagnosis.Diagnosis.moved`): the model as
-    given does not agree."""
+    user modelled re-estimated (:attr:`~gfe_opt.diagnosis.Diagnosis.moved`, 3 σ or more
+    from its given value), with the misfit of the model as given."""
     words = VERDICT_WORDS[result.verdict]
     moved = getattr(result, "moved", None)
     if result.verdict != "consistent" or not moved:
         return words
     which = " and ".join(f"{m['effect']} (effects[{m['index']}])" for m in moved)
     return (f"the model agrees with the test within the noise once its {which} "
-            f"{'is' if len(moved) == 1 else 'are'} re-estimated (see the note); as given "
-            f"it does not (χ²/n {_ratio(result.baseline.chi2_per_residual)}); nothing to add")
+            f"{'is' if len(moved) == 1 else 'are'} re-estimated (as given: χ²/n "
+            f"{_ratio(result.baseline.chi2_per_residual)}; see the note); nothing to add")
 
 
 def withheld_words(withheld: dict) -> str:

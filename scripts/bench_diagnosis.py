@@ -44,8 +44,8 @@ A case is scored:
   the data cannot tell from its finding; or the effect was found beyond the tolerance but
   within twice the σ the tool gave its position; or (``moved``) the last diagnosis says an
   effect the user modelled, of a right name, is not as modelled (its ``moved``: 3 σ or
-  more from its given value; the verdict's words then say the model as given does not
-  agree) and it lies within the place tolerance of the hidden one: a hidden crack 3.6 mm
+  more from its given value; the verdict's words then say it agrees only with that effect
+  re-estimated) and it lies within the place tolerance of the hidden one: a hidden crack 3.6 mm
   from a known one read as that crack, deeper. A case neither right nor said whose last verdict
   claims something (``consistent`` or ``effect_found``) is **confidently wrong**, the worst
   thing the tool can print; ``unexplained`` is not.
