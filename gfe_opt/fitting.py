@@ -449,8 +449,9 @@ class Fit:
 
 
 def jsonable(params: dict) -> dict:
-    """Parameters with numpy values as floats, infinite σ as null (valid JSON); nested
-    lists and dicts (a frame's sensor in ``remaining``) likewise."""
+    """Parameters with numpy values as floats (integers as integers: an index), infinite σ
+    as null (valid JSON); nested lists and dicts (a frame's sensor in ``remaining``)
+    likewise."""
     def one(v):
         if isinstance(v, (list, tuple, np.ndarray)):
             return [one(x) for x in v]
@@ -458,6 +459,10 @@ def jsonable(params: dict) -> dict:
             return {k: one(x) for k, x in v.items()}
         if isinstance(v, str):
             return v
+        if isinstance(v, (bool, np.bool_)):
+            return bool(v)
+        if isinstance(v, (int, np.integer)):
+            return int(v)   # an index stays one (``not_needed``'s and ``moved``'s)
         v = float(v)
         return v if np.isfinite(v) else None
 

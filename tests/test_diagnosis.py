@@ -4,6 +4,8 @@ found first, fitted, removes the error, and then nothing more is added (verdict
 ``consistent``); pairs are found one after the other; a 3 % change of E adds only
 ``material``; a deep beam adds only ``shear``."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -211,8 +213,9 @@ def test_a_known_mass_that_is_not_as_modelled_is_said():
     assert "point_mass (effects[0])" in note and "mass 0.2 -> 0.3" in note
     assert "gfe-opt update MODEL MEASURED writes it re-estimated" in note
     # the JSON says which, and the verdict's words that it agrees only so (misfit as given)
-    (moved,) = d.to_json()["moved"]
+    (moved,) = json.loads(json.dumps(d.to_json()))["moved"]
     assert moved["effect"] == "point_mass" and moved["index"] == 0
+    assert isinstance(moved["index"], int)   # an index, as `update --drop` takes it
     mass = moved["parameters"]["mass"]
     assert mass["given"] == 0.2 and abs(mass["estimate"] / 0.3 - 1) < 0.02
     assert abs(mass["estimate"] - 0.2) >= 3 * mass["sigma"]
@@ -338,6 +341,8 @@ def test_a_present_effect_the_others_make_unnecessary_is_said_and_can_be_dropped
                                   Effect("point_mass", {"position": 0.4, "mass": 0.05})])
     d = diagnose(model, measured, **NOISE)
     assert [(n["effect"], n["index"]) for n in d.not_needed] == [("point_mass", 1)], d.not_needed
+    assert json.loads(json.dumps(d.to_json()))["not_needed"][0]["index"] == 1
+    assert isinstance(json.loads(json.dumps(d.to_json()))["not_needed"][0]["index"], int)
     assert d.not_needed[0]["chi2_rise"] < d.not_needed[0]["needed"]
     assert any("--drop 1" in n for n in d.notes)
     after = update(model, measured, [], drop=[1], **NOISE)
