@@ -142,9 +142,11 @@ def test_a_campaign_subset_meets_the_targets_relaxed_for_its_size():
     assert np.isfinite(card["seconds_per_case"])
 
 
-def _scored(hidden, added, marginal=(), verdict="consistent", caveats=None, sigma=None):
+def _scored(hidden, added, marginal=(), verdict="consistent", caveats=None, sigma=None,
+            moved=None):
     """The campaign's score of a finished loop that added ``added`` [(name, parameters)]
-    (``caveats``: the loop's, as JSON; ``sigma``: each added effect's σ)."""
+    (``caveats``: the loop's, as JSON; ``sigma``: each added effect's σ; ``moved``: the
+    known effects its last diagnosis says are not as modelled, with where it reads them)."""
     from types import SimpleNamespace
 
     sys.path.insert(0, str(ROOT / "scripts"))
@@ -159,6 +161,8 @@ def _scored(hidden, added, marginal=(), verdict="consistent", caveats=None, sigm
     row = {"verdicts": [verdict], "final_effects": []}
     if caveats is not None:
         row["caveats"] = caveats
+    if moved is not None:
+        row["moved"] = moved
     sigma = [{}] * len(effects) if sigma is None else sigma
     bench_diagnosis._score(row, case, make_model(), SimpleNamespace(sigma=sigma),
                            added=effects)
@@ -191,7 +195,8 @@ def test_rescoring_reads_a_crack_against_the_e_its_loop_fitted_as_the_loop_does(
 def test_a_wrong_finding_is_said_when_a_caveat_names_the_truth_else_confidently_wrong():
     """A crack found at the wrong place: "said" when a caveat of the loop names the truth's
     place (its mirror image) or the truth's effect at its place (alike), or when the truth
-    lies within twice the σ the tool gave the place; otherwise, with a verdict that claims
+    lies within twice the σ the tool gave the place, or when the last diagnosis reads a known
+    effect of the truth's kind at its place as moved; otherwise, with a verdict that claims
     something, confidently wrong; ``unexplained`` claims nothing."""
     from .truths import Hidden
 
@@ -217,6 +222,15 @@ def test_a_wrong_finding_is_said_when_a_caveat_names_the_truth_else_confidently_
     assert _scored(crack, near, caveats=[], sigma=[{"position": 0.02 * L}])["said"] \
         == "uncertainty"
     assert _scored(crack, near, caveats=[], sigma=[{"position": 0.01 * L}])["confident_wrong"]
+    # nothing added, but a known crack of the model read as moved (deeper, 3 σ or more) at
+    # the hidden crack's place: said; a known mass there, or the crack 3 % away, is not
+    def moved(name, x):
+        return [{"effect": name, "index": 0, "position": x}]
+
+    at = _scored(crack, [], caveats=[], moved=moved("crack", 0.206 * L))
+    assert at["said"] == "moved" and not at["confident_wrong"] and not at["verdict_right"]
+    assert _scored(crack, [], caveats=[], moved=moved("point_mass", 0.2 * L))["confident_wrong"]
+    assert _scored(crack, [], caveats=[], moved=moved("crack", 0.23 * L))["confident_wrong"]
 
 
 def test_the_campaign_scores_one_zone_over_two_close_cracks_and_ignores_what_data_cannot_show():
