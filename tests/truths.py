@@ -233,8 +233,13 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
         return _shear_case(rng, seed)
     classes = [klass] + ([pair_with] if pair_with else [])
     options = set(CLASS_SUPPORTS[klass]).intersection(*(CLASS_SUPPORTS[c] for c in classes))
+    if known is not None and known["effect"] == "support_spring":
+        # a clamp that gives, known: on supports with a clamp, the spring at its side
+        options = {o for o in options if "clamped" in SUPPORTS[o]}
     name_support = str(rng.choice(sorted(options)))
     supports = SUPPORTS[name_support]
+    if known is not None and known["effect"] == "support_spring":
+        known = {**known, "side": "left" if supports[0] == "clamped" else "right"}
     h = BEAM["h"]
     EI = BEAM["E"] * BEAM["b"] * h**3 / 12
     rho_a = BEAM["rho"] * BEAM["b"] * h
@@ -285,8 +290,10 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
     law_tag = "-" + hidden[0].law if hidden and hidden[0].law else ""
     model = model_dict(supports, elements)
     if known is not None:
-        model["effects"] = [{k: (float(v) if k != "effect" else v) for k, v in known.items()}]
-        tag = {"point_mass": "", "point_spring": "spring-", "crack": "crack-"}[known["effect"]]
+        model["effects"] = [{k: (v if isinstance(v, str) else float(v))
+                             for k, v in known.items()}]
+        tag = {"point_mass": "", "point_spring": "spring-", "crack": "crack-",
+               "support_spring": "clamp-"}[known["effect"]]
         group, law_tag = "known", f"-{tag}{klass}{law_tag}"
     return Case(f"{group}{law_tag}-{name_support}-{seed}", group, model, x, freqs,
                 None if frequency_only else shapes, hidden, stated, factor,
@@ -302,6 +309,8 @@ def _known_part(known, h) -> dict:
         return {"point_masses": [(known["position"], known["mass"])]}
     if known["effect"] == "point_spring":
         return {"point_springs": [(known["position"], known["stiffness"])]}
+    if known["effect"] == "support_spring":   # a clamp that gives: a pin and a spring
+        return {"end_springs": {known["side"]: known["stiffness"]}, "release": known["side"]}
     return {"rigidity": christides_barr(known["position"], known["depth_ratio"], depth=h)}
 
 
@@ -459,7 +468,7 @@ def campaign(seed: int = 2100, subset: int | None = None) -> list[Case]:
 KNOWN_PLAN = [("crack", 4), ("zone", 2), ("mass", 2), ("spring", 2), ("none", 2)]
 #: the known effects, in this order (each a :data:`KNOWN_PLAN` of cases; a kind added later
 #: comes last, so the earlier cases keep their seeds)
-KNOWN_KINDS = ("point_mass", "point_spring", "crack")
+KNOWN_KINDS = ("point_mass", "point_spring", "crack", "support_spring")
 
 
 def known_campaign(seed: int = 2100) -> list[Case]:
@@ -471,7 +480,9 @@ def known_campaign(seed: int = 2100) -> list[Case]:
     hidden springs are 0.5–3), both log-uniform, then a crack found at an earlier
     inspection and written into the file by hand (a/d uniform 0.2–0.5; in the truth the
     Christides–Barr decay of EI(x) in the tests' own code), each at 10–90 % of the
-    length.  Seeds ``seed +
+    length, then a clamp that gives (``support_spring``, 3–30 EI/L log-uniform, at the
+    clamped end of supports drawn among those with a clamp; in the truth a pin with a
+    rotational spring, as the campaign's hidden clamps).  Seeds ``seed +
     1000 + i``; the known effect from its own stream, the rest of each case drawn as
     :func:`draw` draws it."""
     L = BEAM["length"]
@@ -488,12 +499,15 @@ def known_campaign(seed: int = 2100) -> list[Case]:
                                                                          np.log(0.6))))}
                 elif known == "crack":
                     size = {"depth_ratio": float(rng.uniform(0.2, 0.5))}
+                elif known == "support_spring":
+                    size = {"stiffness": EI / L * float(np.exp(rng.uniform(np.log(3.0),
+                                                                           np.log(30.0))))}
                 else:
                     size = {"stiffness": EI * (np.pi / L) ** 3 * float(
                         np.exp(rng.uniform(0.0, np.log(30.0))))}
                 place = round(float(rng.uniform(0.1, 0.9)) * L, 4)
-                cases.append(draw(klass, s, known={"effect": known, "position": place,
-                                                   **size}))
+                at = {} if known == "support_spring" else {"position": place}
+                cases.append(draw(klass, s, known={"effect": known, **at, **size}))
     return cases
 
 
