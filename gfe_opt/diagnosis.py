@@ -1081,17 +1081,20 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
             current = (float("nan") if measured.frequency_only or noise.given else
                shape_correlation(reference.model if reference else model, measured, noise, C))
     verdict = _verdict(ranked, ref_misfit, ref_params, noise, current, measured, model)
+    finding = (together if suggested and together is not None else ranked[0]) \
+        if verdict == "effect_found" else None
+    # selection step 10 on that finding (applied below, where no replacement stands), once
+    form = _form_of_present(model, measured, noise, C, ref_misfit, finding) \
+        if finding is not None and model.effects else None
     swap = _swap(model, measured, noise, reference, names, sel)
-    if swap is not None and verdict == "effect_found":
-        finding = together if suggested and together is not None else ranked[0]
-        if sel.penalised(finding) < sel.penalised(swap[1]) and _form_of_present(
-                model, measured, noise, C, ref_misfit, finding) is None:
-            # an addition that keeps the present effect explains more for its parameters
-            # (and is not withheld by step 10: then the replacement stands, the held-out
-            # block 2370): the effect was on its edge only while the addition was missing
-            # (a known crack re-estimated to nothing beside a missing prop, back at its
-            # depth with it)
-            swap = None
+    if swap is not None and finding is not None and form is None \
+            and sel.penalised(finding) < sel.penalised(swap[1]):
+        # an addition that keeps the present effect explains more for its parameters
+        # (and is not withheld by step 10: then the replacement stands, the held-out
+        # block 2370): the effect was on its edge only while the addition was missing
+        # (a known crack re-estimated to nothing beside a missing prop, back at its
+        # depth with it)
+        swap = None
     replace = None
     if swap is not None:
         # a present effect that ends on the edge of its range, better read as another
@@ -1116,8 +1119,7 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
                      f"gfe-opt update MODEL MEASURED --drop {index} --add {alt.name}")
     withheld = None
     if verdict == "effect_found" and replace is None and model.effects:
-        finding = together if suggested and together is not None else ranked[0]
-        withheld = _form_of_present(model, measured, noise, C, ref_misfit, finding)
+        withheld = form   # (no replacement: the finding is the one it was computed for)
         if withheld is not None:
             # the notes that said to add what is withheld give way to the one that says
             # why it is not named ("the stiffness_profile explains it to the noise" just
