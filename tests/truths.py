@@ -233,9 +233,9 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
         return _shear_case(rng, seed)
     classes = [klass] + ([pair_with] if pair_with else [])
     options = set(CLASS_SUPPORTS[klass]).intersection(*(CLASS_SUPPORTS[c] for c in classes))
-    if known is not None and known["effect"] == "support_spring":
-        # a clamp that gives, known: on supports with a clamp, the spring at its side
-        options = {o for o in options if "clamped" in SUPPORTS[o]}
+    if known is not None and known["effect"] in KNOWN_SUPPORTS:
+        # a clamp or a pin that gives, or a preload: only on the supports that hold it
+        options = {o for o in options if KNOWN_SUPPORTS[known["effect"]](SUPPORTS[o])}
     name_support = str(rng.choice(sorted(options)))
     supports = SUPPORTS[name_support]
     if known is not None and known["effect"] == "support_spring":
@@ -293,7 +293,9 @@ def draw(klass: str, seed: int, *, pair_with: str | None = None, frequency_only=
         model["effects"] = [{k: (v if isinstance(v, str) else float(v))
                              for k, v in known.items()}]
         tag = {"point_mass": "", "point_spring": "spring-", "crack": "crack-",
-               "support_spring": "clamp-"}[known["effect"]]
+               "support_spring": "clamp-", "support_translation": "pin-",
+               "axial_load": "preload-", "foundation": "foundation-",
+               "section_loss": "zone-"}[known["effect"]]
         group, law_tag = "known", f"-{tag}{klass}{law_tag}"
     return Case(f"{group}{law_tag}-{name_support}-{seed}", group, model, x, freqs,
                 None if frequency_only else shapes, hidden, stated, factor,
@@ -311,6 +313,18 @@ def _known_part(known, h) -> dict:
         return {"point_springs": [(known["position"], known["stiffness"])]}
     if known["effect"] == "support_spring":   # a clamp that gives: a pin and a spring
         return {"end_springs": {known["side"]: known["stiffness"]}, "release": known["side"]}
+    if known["effect"] == "support_translation":   # a pin that gives: a free end on a spring
+        return {"point_springs": [(BEAM["length"], known["stiffness"])], "free_right": True}
+    if known["effect"] == "axial_load":
+        return {"tension": known["tension"]}
+    if known["effect"] == "foundation":
+        return {"foundation": known["stiffness"]}
+    if known["effect"] == "section_loss":   # sharp edges: a ramp of a thousandth of the zone
+        edge = 1e-3 * known["length"]
+        return {"rigidity": smooth_zone(known["position"], known["length"],
+                                        known["stiffness_ratio"], edge),
+                "mass": smooth_zone(known["position"], known["length"], known["mass_ratio"],
+                                    edge)}
     return {"rigidity": christides_barr(known["position"], known["depth_ratio"], depth=h)}
 
 
@@ -468,7 +482,20 @@ def campaign(seed: int = 2100, subset: int | None = None) -> list[Case]:
 KNOWN_PLAN = [("crack", 4), ("zone", 2), ("mass", 2), ("spring", 2), ("none", 2)]
 #: the known effects, in this order (each a :data:`KNOWN_PLAN` of cases; a kind added later
 #: comes last, so the earlier cases keep their seeds)
-KNOWN_KINDS = ("point_mass", "point_spring", "crack", "support_spring")
+KNOWN_KINDS = ("point_mass", "point_spring", "crack", "support_spring", "support_translation",
+               "axial_load", "foundation", "section_loss")
+#: the supports (left, right) a known effect needs: a clamp that gives a clamp, a pin that
+#: gives a pin at the right end (the truth frees it onto a spring), a preload both ends held
+#: along the axis as the campaign's hidden tension
+KNOWN_SUPPORTS = {
+    "support_spring": lambda s: "clamped" in s,
+    "support_translation": lambda s: s[1] == "pinned",
+    "axial_load": lambda s: s in (("pinned", "pinned"), ("clamped", "clamped")),
+}
+
+
+#: the known effects without a place along the beam
+GLOBAL_KNOWN = ("support_spring", "support_translation", "axial_load", "foundation")
 
 
 def known_campaign(seed: int = 2100) -> list[Case]:
@@ -482,7 +509,13 @@ def known_campaign(seed: int = 2100) -> list[Case]:
     Christides–Barr decay of EI(x) in the tests' own code), each at 10–90 % of the
     length, then a clamp that gives (``support_spring``, 3–30 EI/L log-uniform, at the
     clamped end of supports drawn among those with a clamp; in the truth a pin with a
-    rotational spring, as the campaign's hidden clamps).  Seeds ``seed +
+    rotational spring, as the campaign's hidden clamps), then a pin that gives
+    (``support_translation`` at a pinned right end, 10–300 EI/L³ log-uniform; in the truth
+    a free end on a spring), an axial preload (``axial_load``, ±0.1–0.6 π²EI/L², pinned or
+    clamped at both ends), a foundation (0.3–3 EI (π/L)⁴ log-uniform) and a zone
+    (``section_loss`` 6–15 % of the length, EI × 0.5–0.8 or 1.3–1.8, ρA × that to a power
+    0.3–1, inside the beam; in the truth the tests' own zone with edges a thousandth of its
+    length).  Seeds ``seed +
     1000 + i``; the known effect from its own stream, the rest of each case drawn as
     :func:`draw` draws it."""
     L = BEAM["length"]
@@ -502,11 +535,30 @@ def known_campaign(seed: int = 2100) -> list[Case]:
                 elif known == "support_spring":
                     size = {"stiffness": EI / L * float(np.exp(rng.uniform(np.log(3.0),
                                                                            np.log(30.0))))}
+                elif known == "support_translation":
+                    size = {"stiffness": EI / L**3 * float(np.exp(rng.uniform(np.log(10.0),
+                                                                              np.log(300.0)))),
+                            "side": "right"}
+                elif known == "axial_load":
+                    size = {"tension": float(rng.uniform(0.1, 0.6) * rng.choice([-1.0, 1.0])
+                                             * np.pi**2 * EI / L**2)}
+                elif known == "foundation":
+                    size = {"stiffness": EI * (np.pi / L) ** 4 * float(
+                        np.exp(rng.uniform(np.log(0.3), np.log(3.0))))}
+                elif known == "section_loss":
+                    ratio = float(rng.uniform(1.3, 1.8) if rng.integers(2)
+                                  else rng.uniform(0.5, 0.8))
+                    size = {"length": round(float(rng.uniform(0.06, 0.15)) * L, 4),
+                            "stiffness_ratio": ratio,
+                            "mass_ratio": float(ratio ** rng.uniform(0.3, 1.0))}
                 else:
                     size = {"stiffness": EI * (np.pi / L) ** 3 * float(
                         np.exp(rng.uniform(0.0, np.log(30.0))))}
                 place = round(float(rng.uniform(0.1, 0.9)) * L, 4)
-                at = {} if known == "support_spring" else {"position": place}
+                if known == "section_loss":   # the zone inside the beam
+                    half = size["length"] / 2 + 0.02 * L
+                    place = round(float(np.clip(place, half, L - half)), 4)
+                at = {} if known in GLOBAL_KNOWN else {"position": place}
                 cases.append(draw(klass, s, known={"effect": known, **at, **size}))
     return cases
 
