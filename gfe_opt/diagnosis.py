@@ -60,6 +60,7 @@ Verdict
 
 from __future__ import annotations
 
+import copy
 import functools
 import multiprocessing
 import os
@@ -524,8 +525,9 @@ def _groups(name, starts, given, seeds) -> list[list[dict]]:
 def _fit_group(model, measured, name, noise, group, extra, thorough):
     return fit_effects(model, measured, [*extra, Effect(name, group[0])], noise=noise,
                        name=name, alternatives=group[1:],
-                       multistart=True if thorough or extra and measured.frequency_only
-                       else "auto")
+                       multistart=("valleys" if thorough and not measured.frequency_only
+                                   else True if (extra or thorough) and measured.frequency_only
+                                   else "auto"))
 
 
 def _candidate_args(payload) -> list:
@@ -631,6 +633,25 @@ def _job(args):
               "generic": _generic_only, "draw": _draw,
               "without": _fit_without}[kind](*payload)
     return result, SOLVER_TALLY - before
+
+
+def _reused_jobs(jobs, progress, labels, reuse: dict) -> list:
+    """:func:`_run_jobs`, except the jobs whose (index, label) ``reuse`` holds: a copy of
+    that result (a diagnosis's second pass, :func:`_again_thorough`: its jobs are the first
+    pass's in the same order, those fitted again from every start labelled apart).  Each
+    result run is copied into ``reuse`` before the diagnosis marks it."""
+    keys = list(enumerate(labels))
+    todo = [j for j, key in enumerate(keys) if key not in reuse]
+    ran = _run_jobs([jobs[j] for j in todo], progress, [labels[j] for j in todo]) \
+        if todo else []
+    out = [None] * len(jobs)
+    for j, result in zip(todo, ran):
+        out[j] = result
+        reuse[keys[j]] = copy.deepcopy(result)
+    for j, key in enumerate(keys):
+        if out[j] is None:
+            out[j] = copy.deepcopy(reuse[key])
+    return out
 
 
 def _run_jobs(jobs, progress, labels):
@@ -846,41 +867,46 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     relative (None: not given; defaults 0.05 % and 0.3 % are assumed and the data's own
     level is estimated).  ``progress`` is called as ``progress(done, total, name)``.  With
     ``realise`` the generic-element update is run (a frame's member by member) and read in
-    words.  ``thorough``: the candidates fitted from every start and every valley of their
-    grids (:func:`fit_effects` with ``multistart=True``), mode shapes or not; None: the
-    diagnosis decides (:func:`_again_thorough`)."""
+    words.  ``thorough``: the candidates fitted again from the best grid point of every
+    other valley along their place (:func:`fit_effects` with ``multistart="valleys"``; from
+    frequencies alone from every start, as a pair is); None: the diagnosis decides
+    (:func:`_again_thorough`)."""
     start = time.perf_counter()
+    reuse = {}
     result = _diagnose(model, measured, candidates, freq_noise, shape_noise, progress,
-                       realise, thorough or ())
+                       realise, thorough or (), reuse)
     again = _again_thorough(result, measured) if thorough is None else ()
     if again:
+        # the fits the first pass made alike (the other candidates, the present effects
+        # taken out, the generic update) are its own, copied before it judged them
         result = _diagnose(model, measured, candidates, freq_noise, shape_noise, progress,
-                           realise, again)
+                           realise, again, reuse)
         result.thorough = again
         result.notes.append(
             f"one start each left no effect explaining the difference: {', '.join(again)} "
-            "fitted again from every start and every valley of "
-            f"{'its grid' if len(again) == 1 else 'their grids'}")
+            "fitted again from every valley of "
+            f"{'its grid' if len(again) == 1 else 'their grids'} along the structure")
     result.seconds = time.perf_counter() - start
     return result
 
 
 def _again_thorough(result, measured) -> tuple:
-    """The candidates to fit again from every start and valley before the verdict "none of
-    the effects I know explains the difference" stands: those that gained (not failed),
-    each fitted from its grid's best point alone, where data with shapes fit it from one
-    start.  That verdict is a claim about every effect, and one start can end in the
-    wrong valley: a known stiffer zone beside a hidden one (known-zone 3290) let the grid's
-    coarse sizes rank a lighter zone elsewhere first, whose valley ended at χ²/n 10.4,
-    while the hidden zone's valley, reached from another start, ends at 2.3."""
+    """The candidates to fit again from every valley of their grid before the verdict "none
+    of the effects I know explains the difference" stands: those with a place that gained
+    (not failed), which data with shapes fit from the grid's best point alone.  That
+    verdict is a claim about every effect, and one start can end in the wrong valley: a
+    known stiffer zone beside a hidden one (known-zone 3290) let the grid's coarse sizes
+    rank a lighter zone elsewhere first, whose valley ended at χ²/n 10.4, while the hidden
+    zone's valley, reached from its own best grid point, ends at 2.3."""
     if result.verdict != "unexplained" or measured.frequency_only:
         return ()   # (frequencies alone: every start is tried where a fit misses the noise)
     return tuple(f.name for f in result.fits
-                 if not getattr(effect_type(f.name), "fallback", False))
+                 if not getattr(effect_type(f.name), "fallback", False)
+                 and any(p.name == "position" for p in effect_type(f.name).parameters))
 
 
 def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, realise,
-              thorough) -> Diagnosis:
+              thorough, reuse) -> Diagnosis:
     noise = noise_of(freq_noise, shape_noise)
     names = _candidates(model, candidates)
     layout = structure(model)
@@ -913,7 +939,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
             continue
         jobs.append(("candidate", (model, measured, name, noise, hint, None, (), (),
                                    name in thorough)))
-        labels.append(name + (" (every start)" if name in thorough else ""))
+        labels.append(name + (" (every valley)" if name in thorough else ""))
     if candidates is not None and not jobs and not fallback_names:
         raise GfeInputError(measured.source, "modes", "; ".join(f"{n}: {r}"
                                                                 for n, r in skipped))
@@ -933,7 +959,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
         labels.append("generic-element update")
         jobs += [("draw", (model, c, noise)) for c in copies]
         labels += [f"its noise band ({i + 1} of {len(copies)})" for i in range(len(copies))]
-    fits = _run_jobs(jobs, progress, labels) if jobs else []
+    fits = _reused_jobs(jobs, progress, labels, reuse)
     draws = fits[len(fits) - len(copies):]
     fits = fits[:len(fits) - len(copies)]
     generic, band = _band(model, measured, noise, fits.pop(), draws) if with_generic \
@@ -1726,11 +1752,38 @@ def _undetermined(fit, model) -> list:
     for effects in fit.equivalent:
         if symmetric and _mirrored(fit.effects, effects, model.length):
             continue
+        if _same_additions(fit, effects, len(model.effects)):
+            continue
         if model.kind == "frame" and (_swapped(fit.effects, effects, model)
                                       or _frame_mirrored(fit, effects)):
             continue
         out.append(effects)
     return out
+
+
+def _same_additions(fit, effects, present: int) -> bool:
+    """Whether ``effects`` (an end that fits as well as ``fit``) holds the effects ``fit``
+    adds to the ``present`` ones each where it has them, every fitted parameter within
+    twice its σ (names and choices equal): the two ends differ only in how the present
+    effects are re-estimated (a known zone's length against its ratio), which does not
+    leave the finding undetermined."""
+    if len(effects) != len(fit.effects) or len(effects) <= present:
+        return False
+    for i in range(present, len(effects)):
+        a, b = fit.effects[i], effects[i]
+        if a.name != b.name:
+            return False
+        sigma = fit.sigma[i] if i < len(fit.sigma) else {}
+        for key, value in a.parameters.items():
+            other = b.parameters.get(key)
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                s = sigma.get(key)
+                if not isinstance(other, (int, float)) or s is None or not np.isfinite(s) \
+                        or abs(other - value) > 2.0 * s:
+                    return False
+            elif other != value:
+                return False
+    return True
 
 
 def _frame_mirrored(fit, effects) -> bool:

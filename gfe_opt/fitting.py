@@ -714,8 +714,16 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
             if other[3] and other[1] < ends[0][1] - FINISH_SETTLED * floor:
                 ends[0] = other
         at_noise = min(e[1] for e in ends) <= chdtri(max(n_res - z.size, 1), 1.0 - 0.999)
-        if multistart is True or (multistart == "auto" and not at_noise
-                                  and measured.frequency_only):
+        if multistart == "valleys":
+            # from the best grid point of every other valley along the last effect's place
+            more = []
+            for v in valleys:
+                v = problem.untied(np.clip(v, lower, upper))
+                if not any(np.array_equal(v, s) for s in (first, *more)):
+                    more.append(v)
+            ends += [_minimise(residual, chi2, z0, lower, upper, max_iter) for z0 in more]
+        elif multistart is True or (multistart == "auto" and not at_noise
+                                    and measured.frequency_only):
             # effects that trade against each other (a soft clamp and a tip mass fitted
             # from frequencies: χ² rises 1e4-fold when the clamp alone moves 25 %) sit in a
             # narrow valley no coarse grid point hits: at each grid point of the last

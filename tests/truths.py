@@ -498,7 +498,7 @@ KNOWN_SUPPORTS = {
 GLOBAL_KNOWN = ("support_spring", "support_translation", "axial_load", "foundation")
 
 
-def known_campaign(seed: int = 2100) -> list[Case]:
+def known_campaign(seed: int = 2100, seeds=None) -> list[Case]:
     """Cases whose model file holds a known effect (in the truth too) and one hidden effect
     of :data:`KNOWN_PLAN` beside it (or none): the known effect is part of the structure
     the user modelled, not a finding, and what is hidden must be found as on a beam without
@@ -517,7 +517,8 @@ def known_campaign(seed: int = 2100) -> list[Case]:
     0.3–1, inside the beam; in the truth the tests' own zone with edges a thousandth of its
     length).  Seeds ``seed +
     1000 + i``; the known effect from its own stream, the rest of each case drawn as
-    :func:`draw` draws it."""
+    :func:`draw` draws it.  ``seeds``: only the cases of these seeds (each case draws
+    from its own seed, so they are the same as in the whole list)."""
     L = BEAM["length"]
     beam_mass = BEAM["rho"] * BEAM["b"] * BEAM["h"] * L
     EI = BEAM["E"] * BEAM["b"] * BEAM["h"] ** 3 / 12
@@ -526,6 +527,8 @@ def known_campaign(seed: int = 2100) -> list[Case]:
         for klass, count in KNOWN_PLAN:
             for _ in range(count):
                 s += 1
+                if seeds is not None and s not in seeds:
+                    continue
                 rng = np.random.default_rng([s, 1])
                 if known == "point_mass":
                     size = {"mass": beam_mass * float(np.exp(rng.uniform(np.log(0.05),
