@@ -317,7 +317,7 @@ class Diagnosis:
     #: model gives: [{"effect", "index", "parameters": {key: {"given", "estimate",
     #: "sigma"}}}] (``diagnose --json``'s ``moved``; the verdict reads them re-estimated)
     moved: list = field(default_factory=list)
-    #: the candidates fitted from every start and valley of their grids
+    #: the candidates fitted again from every valley of their grids before the verdict
     #: (:func:`_again_thorough`): a beam's suggestion names their place (``add_arguments``)
     thorough: tuple = ()
 
@@ -638,7 +638,7 @@ def _job(args):
 def _reused_jobs(jobs, progress, labels, reuse: dict) -> list:
     """:func:`_run_jobs`, except the jobs whose (index, label) ``reuse`` holds: a copy of
     that result (a diagnosis's second pass, :func:`_again_thorough`: its jobs are the first
-    pass's in the same order, those fitted again from every start labelled apart).  Each
+    pass's in the same order, those fitted again from every valley labelled apart).  Each
     result run is copied into ``reuse`` before the diagnosis marks it."""
     keys = list(enumerate(labels))
     todo = [j for j, key in enumerate(keys) if key not in reuse]

@@ -656,8 +656,10 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     fit of frequencies alone does not reach the noise (``multistart="auto"``; with shapes
     the valleys are wide enough) or always (``True``), the fit runs
     again from profile starts (:func:`_profile_starts`: effects that trade against each
-    other, a soft clamp and a tip mass) and, with ``True``, from every alternative; the
-    best end is kept, and ends that fit as well elsewhere are the fit's ``equivalent``.
+    other, a soft clamp and a tip mass) and, with ``True``, from every alternative; with
+    ``"valleys"`` it runs again from the best grid point of every other valley along the
+    last added effect's place (:func:`_valleys`), shapes or not; the best end is kept, and
+    ends that fit as well elsewhere are the fit's ``equivalent``.
     ``jacobian``: ``"analytic"`` (eigen-derivatives, :func:`point_jacobian`) or
     ``"difference"`` (of the modal solves); default :data:`JACOBIAN`."""
     problem = fit_problem(model, measured, adding, noise=noise, C=C, jacobian=jacobian)
@@ -714,14 +716,18 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
             if other[3] and other[1] < ends[0][1] - FINISH_SETTLED * floor:
                 ends[0] = other
         at_noise = min(e[1] for e in ends) <= chdtri(max(n_res - z.size, 1), 1.0 - 0.999)
-        if multistart == "valleys":
-            # from the best grid point of every other valley along the last effect's place
-            more = []
+        def other_valleys(taken):   # the best grid point of every valley not yet started
+            out = []
             for v in valleys:
                 v = problem.untied(np.clip(v, lower, upper))
-                if not any(np.array_equal(v, s) for s in (first, *more)):
-                    more.append(v)
-            ends += [_minimise(residual, chi2, z0, lower, upper, max_iter) for z0 in more]
+                if not any(np.array_equal(v, s) for s in (*taken, *out)):
+                    out.append(v)
+            return out
+
+        if multistart == "valleys":
+            # from the best grid point of every other valley along the last effect's place
+            ends += [_minimise(residual, chi2, z0, lower, upper, max_iter)
+                     for z0 in other_valleys([first])]
         elif multistart is True or (multistart == "auto" and not at_noise
                                     and measured.frequency_only):
             # effects that trade against each other (a soft clamp and a tip mass fitted
@@ -739,10 +745,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
                 # few tenths of the length, and the grid's coarse depths can rank the one
                 # holding the optimum (χ² 8.6) below another (2 887): a confident wrong
                 # answer when another effect fits better than the wrong valley
-                for v in valleys:
-                    v = problem.untied(np.clip(v, lower, upper))
-                    if not any(np.array_equal(v, s) for s in (first, *more)):
-                        more.append(v)
+                more += other_valleys([first, *more])
             ends += [_minimise(residual, chi2, z0, lower, upper, max_iter) for z0 in more]
         # each end as its effects lie on the structure (a zone fitted past an end: the part
         # on it), so that ends that are one structure compare equal
