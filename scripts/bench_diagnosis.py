@@ -5,8 +5,8 @@ the package did not build, scored.
     python scripts/bench_diagnosis.py --known [--seed S] [--json out.json]
 
 ``--known`` runs another list instead (``truths.known_campaign``): the model file holds a
-known effect (an attached mass, a spring to ground, a crack found before, a clamp that
-gives), in the truth too, and one hidden effect (or none) is to be found beside it; the
+known effect (an attached mass, a spring to ground, a crack found before, a clamp or a
+pin that gives, an axial preload, a foundation, a zone), in the truth too, and one hidden effect (or none) is to be found beside it; the
 known effect is not a finding and is not scored as one.
 
 Cases come from ``tests/truths.py`` (a fixed, seeded list: every hidden class alone, pairs,
@@ -675,8 +675,8 @@ def main(argv=None) -> int:
     parser.add_argument("--json", type=Path, help="also write the scorecard here")
     parser.add_argument("--cases", nargs="*", help="only cases whose name contains these")
     parser.add_argument("--known", action="store_true",
-                        help="the cases whose model holds a known mass, spring, crack or "
-                        "flexible clamp "
+                        help="the cases whose model holds a known mass, spring, crack, "
+                        "flexible clamp or pin, preload, foundation or zone "
                         "(truths.known_campaign) instead of the campaign's")
     parser.add_argument("--rescore", type=Path,
                         help="score the loops stored in this --json file again (no runs)")
