@@ -1228,7 +1228,10 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
     # hidden one stays where it was beside it), else re-estimated alone
     moved = _known_moved(model, (together if together is not None else ranked[0])
                          if verdict == "effect_found" and replace is None else reference)
-    notes += [_moved_note(m, baseline, ref_misfit) for m in moved]
+    notes += [_moved_note(m, baseline, ref_misfit,
+                          None if verdict == "effect_found" else
+                          _beside_as_given(m, model, ranked, ref_misfit, sel))
+              for m in moved]
     if measured.frequency_only:
         notes.append(measured.without_shapes_note())
         if realise:
@@ -1287,15 +1290,47 @@ def _known_moved(model, reference) -> list[dict]:
     return out
 
 
-def _moved_note(moved: dict, baseline, ref_misfit) -> str:
-    """The note of one :func:`_known_moved` record, both values and both misfits."""
+def _moved_note(moved: dict, baseline, ref_misfit, beside=None) -> str:
+    """The note of one :func:`_known_moved` record, both values and both misfits, and
+    ``beside`` (:func:`_beside_as_given`) where a candidate fits as well with it as given."""
     values = ", ".join(f"{key} {v['given']:.4g} -> {v['estimate']:.4g} ± {v['sigma']:.2g}"
                        for key, v in moved["parameters"].items())
+    other = "" if beside is None else (
+        f"; with it as given, {beside.describe()} beside it fits as well (χ²/n "
+        f"{beside.misfit.chi2_per_residual:.3g} against {ref_misfit.chi2_per_residual:.3g} "
+        "re-estimated): the data do not tell which")
     return (f"the model's {moved['effect']} (effects[{moved['index']}]) is not as the data "
             f"read it: {values} (χ²/n {baseline.chi2_per_residual:.3g} as modelled, "
             f"{ref_misfit.chi2_per_residual:.3g} re-estimated; the verdict reads it "
             "re-estimated): a known part that is not as modelled, or another effect beside "
-            "it that it takes up; gfe-opt update MODEL MEASURED writes it re-estimated")
+            f"it that it takes up{other}; gfe-opt update MODEL MEASURED writes it "
+            "re-estimated")
+
+
+def _beside_as_given(moved: dict, model, fits, ref_misfit, sel):
+    """Of the candidates fitted (each beside the present effects re-estimated), the one with
+    the lowest χ² that is determined (every parameter estimable, its size
+    :data:`SIZE_SIGMAS` σ from nothing), leaves the moved known effect where the model
+    gives it (every moved parameter within :data:`SIZE_SIGMAS` of its σ in that fit) and
+    fits as well as the moved reading or better (χ² within the 95 % χ²₁ quantile of the
+    noise floor, or lower): the other effect it may be taking up, named (a hidden prop
+    beside a known tension, which re-estimated alone read as 65 % more tension:
+    known-preload 3169).  None when no candidate does."""
+    best = None
+    for f in fits:
+        if f.added is None or f.failed or not f.success or f.unidentified \
+                or not f.size_sigmas >= SIZE_SIGMAS or moved["index"] >= len(f.effects) \
+                or f.effects[moved["index"]].name != moved["effect"]:
+            continue
+        again, sigma = f.effects[moved["index"]].parameters, f.sigma[moved["index"]]
+        kept = all(isinstance(again.get(k), (int, float)) and sigma.get(k) is not None
+                   and np.isfinite(sigma[k]) and sigma[k] > 0
+                   and abs(again[k] - v["given"]) < SIZE_SIGMAS * sigma[k]
+                   for k, v in moved["parameters"].items())
+        if kept and f.misfit.chi2 <= ref_misfit.chi2 + ALIKE_CHI2 * sel.floor \
+                and (best is None or f.misfit.chi2 < best.misfit.chi2):
+            best = f
+    return best
 
 
 class Recommendation(str):
