@@ -6,8 +6,9 @@ the package did not build, scored.
 
 ``--known`` runs another list instead (``truths.known_campaign``): the model file holds a
 known effect (an attached mass, a spring to ground, a crack found before, a clamp or a
-pin that gives, an axial preload, a foundation, a zone), in the truth too, and one hidden effect (or none) is to be found beside it; the
-known effect is not a finding and is not scored as one.
+pin that gives, an axial preload, a foundation, a zone), in the truth too, and one hidden
+effect (or none) is to be found beside it; the known effect is not a finding and is not
+scored as one.
 
 Cases come from ``tests/truths.py`` (a fixed, seeded list: every hidden class alone, pairs,
 every support, other crack laws, smooth zones, tapers, deep beams, frequency-only sets,
