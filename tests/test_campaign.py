@@ -306,6 +306,7 @@ def test_a_known_effect_case_scores_what_the_loop_found_not_what_the_model_held(
     assert row["position_error_pct"][0] < 2.0
 
 
+@pytest.mark.slow  # a whole loop with the second pass, about 30 s: .ci/run runs it
 def test_a_hidden_zone_beside_a_known_one_is_found_from_another_start_not_left_unexplained():
     """A case of ``bench_diagnosis.py --known``: the model file holds a stiffer zone (a
     repair plate, 0.50 m, EI × 1.34) and a second stiffer zone is hidden at 0.16 m (EI ×
