@@ -872,20 +872,21 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     frequencies alone from every start, as a pair is); None: the diagnosis decides
     (:func:`_again_thorough`)."""
     start = time.perf_counter()
-    reuse = {}
+    reuse, names = {}, tuple(thorough or ())
     result = _diagnose(model, measured, candidates, freq_noise, shape_noise, progress,
-                       realise, thorough or (), reuse)
+                       realise, names, reuse)
     again = _again_thorough(result, measured) if thorough is None else ()
     if again:
         # the fits the first pass made alike (the other candidates, the present effects
         # taken out, the generic update) are its own, copied before it judged them
         result = _diagnose(model, measured, candidates, freq_noise, shape_noise, progress,
                            realise, again, reuse)
-        result.thorough = again
+        names = again
         result.notes.append(
             f"one start each left no effect explaining the difference: {', '.join(again)} "
             "fitted again from every valley of "
             f"{'its grid' if len(again) == 1 else 'their grids'} along the structure")
+    result.thorough = names
     result.seconds = time.perf_counter() - start
     return result
 

@@ -406,3 +406,26 @@ def test_a_profile_the_information_criterion_prefers_over_the_explaining_pair_is
     # 9 parameters for 0.5 lower: 3 ln 108 = 14 more in the criterion than the drop pays
     assert _close_profile(fit("stiffness_profile", 90.9, 9), pair, sel) == []
     assert _close_profile(fit("stiffness_profile", 92.0, 2), pair, sel) == []
+
+
+def test_a_candidate_fitted_from_every_valley_gives_update_its_place_as_a_start():
+    """``diagnose(thorough=...)`` fits those candidates again from every valley of their
+    grid (selection step 11 does so before ``unexplained`` stands); on a beam the
+    suggestion then carries the place found as ``update``'s start
+    (``crack:position=...``), and ``update`` with it ends where the diagnosis did.  Without
+    the second pass the suggestion is the name alone.  Data: the reference beam (not the
+    package's model) with a Christides–Barr crack at 0.15 m, a/d 0.35."""
+    measured = reference_data(rigidity=christides_barr(0.15, 0.35))
+    model = make_model()
+    d = diagnose(model, measured, thorough=("crack",), **NOISE)
+    assert d.verdict == "effect_found" and d.thorough == ("crack",)
+    (arg,) = d.add_arguments()
+    name, place = arg.split(":")
+    x = float(place.removeprefix("position="))
+    assert name == "crack" and x == d.best.parameters["position"]
+    assert abs(x - 0.15) < 0.01 * L
+    u = update(model, measured, [arg], **NOISE)
+    assert abs(u.model.effects[0].parameters["position"] - x) < 1e-4 * L
+    assert abs(u.fit.misfit.chi2 / d.best.misfit.chi2 - 1) < 1e-6
+    plain = diagnose(model, measured, **NOISE)
+    assert plain.thorough == () and plain.add_arguments() == ["crack"]
