@@ -313,7 +313,7 @@ def test_a_hidden_zone_beside_a_known_one_is_found_from_another_start_not_left_u
     1.45, in the truth with smooth edges).  Fitted from its grid's best point alone, a
     further zone ends in another valley (a long lighter zone at 0.42 m, χ²/n 10.4), and
     the diagnosis said that nothing it knows explains the difference.  Before it says so the
-    candidates that gained are fitted from every start and valley: the hidden zone is found
+    candidates that gained are fitted again from every valley: the hidden zone is found
     where it is, the suggestion names that place for ``update``'s start, and the loop ends
     ``consistent`` with the known zone the user's, where it was."""
     sys.path.insert(0, str(ROOT / "scripts"))
