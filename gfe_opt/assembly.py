@@ -84,13 +84,8 @@ class Discretisation:
 
     def stiffness_elements(self, params=None) -> np.ndarray:
         """Generic element stiffness in physical DOFs, (n_elements, n, n)."""
-        params = self.stiffness_params if params is None else params
-        L = self.element_length
-        if self.kind == "bar":
-            return el.generic_bar_stiffness(params["k"], L)
-        t = el.beam_dof_scaling(L)
-        ks = el.generic_beam_stiffness(params["k_ww"], params["k_wt"], params["k_tt"])
-        return ks * (t[:, None] * t[None, :]) / L**3
+        return stiffness_elements(self.kind, self.stiffness_params if params is None else params,
+                                  self.element_length)
 
     def element_strain_energy(self, shapes, params=None) -> np.ndarray:
         r"""Twice the generic strain energy :math:`φ_e^T K_e φ_e` per element, (n_elements, n).
@@ -278,36 +273,81 @@ class Builder:
     # -- the elements -------------------------------------------------------------------
     def discretisation(self) -> "Discretisation":
         model = self.model
-        n, L = model.elements, model.element_length
+        L = model.element_length
         beam = model.kind == "beam"
-        size = 4 if beam else 2
         E = model.youngs_modulus
         rigidity = E * (model.inertia if beam else model.area)
         params, shear_g = self._stiffness(rigidity)
         mass = self._mass(E)
+        extra = self._extra()
         constrained = set(constrained_dofs(model).tolist())
-        extra = np.zeros((n, size, size))
-        tt = np.outer(*(2 * [el.beam_dof_scaling(L)])) if beam else np.ones((2, 2))
-        for term in self.element_terms:
-            extra = extra + term(L) * tt
-        for x, k in self.point_stiffness:
-            e, shape = self._shape_at(x)
-            extra[e] += k * np.outer(shape, shape)
-        for x, m in self.point_masses:
-            e, shape = self._shape_at(x)
-            mass[e] += m * np.outer(shape, shape)
-        nodal = []
-        for side, k, translation in self.end_springs:
-            node = 0 if side == "left" else n
-            dof = (2 * node if beam else node) if translation else 2 * node + 1
+        nodal = self.nodal_springs()
+        for dof, _ in nodal:
             constrained.discard(dof)  # a support that gives: the spring replaces the fixity
-            nodal.append((dof, k))
         scale = rigidity / (model.mass_per_length * model.length ** (4 if beam else 2))
         return Discretisation(kind=model.kind, nodes=model.nodes, element_length=L,
                               stiffness_params=params, mass=mass, extra_stiffness=extra,
                               nodal_stiffness=tuple(nodal),
                               constrained=np.array(sorted(constrained), dtype=int),
                               eigenvalue_scale=scale, shear_g=shear_g)
+
+    def nodal_springs(self) -> list:
+        """``(dof, k)`` of the end springs (each frees the DOF it is on)."""
+        n, beam = self.model.elements, self.model.kind == "beam"
+        nodal = []
+        for side, k, translation in self.end_springs:
+            node = 0 if side == "left" else n
+            dof = (2 * node if beam else node) if translation else 2 * node + 1
+            nodal.append((dof, k))
+        return nodal
+
+    def element_matrices(self, elements: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Generic stiffness, extra stiffness terms and mass of the ``elements`` (sorted
+        indices) in physical DOFs, (len, n, n) each: the numbers :meth:`discretisation`
+        gives them, without building the others (a fit's Jacobian differences the
+        elements one effect changes, :func:`local_difference`).  Not for a shear beam (its
+        g couples the sensors' reading to the elements)."""
+        if self.shear_rigidity is not None:
+            raise ValueError("element_matrices: a shear beam's elements are built whole")
+        model = self.model
+        E = model.youngs_modulus
+        rigidity = E * (model.inertia if model.kind == "beam" else model.area)
+        params, _ = self._stiffness(rigidity, elements)
+        return (stiffness_elements(model.kind, params, model.element_length),
+                self._extra(elements), self._mass(E, elements))
+
+    def footprint(self) -> np.ndarray | None:
+        """The elements this builder's effects change, sorted (their nodal springs aside),
+        or None when they change every element (a factor without support, an element term,
+        shear)."""
+        n, L = self.model.elements, self.model.element_length
+        if self.element_terms or self.shear_rigidity is not None:
+            return None
+        out = []
+        for f in (*self.rigidity, *self.mass):
+            if f.support is None:
+                return None
+            out.append(np.arange(*_support_range(f.support, L, n)))
+        out += [[self._shape_at(x)[0]] for x, _ in (*self.point_stiffness, *self.point_masses)]
+        return np.unique(np.concatenate(out)).astype(int) if out else np.zeros(0, dtype=int)
+
+    def _extra(self, only=None) -> np.ndarray:
+        """Element stiffness terms outside the generic family (element terms, point
+        springs), physical DOFs; ``only``: of those elements."""
+        model = self.model
+        n, L = model.elements, model.element_length
+        beam = model.kind == "beam"
+        size = 4 if beam else 2
+        place = _places(n, only)
+        extra = np.zeros((n if only is None else len(only), size, size))
+        tt = np.outer(*(2 * [el.beam_dof_scaling(L)])) if beam else np.ones((2, 2))
+        for term in self.element_terms:
+            extra = extra + term(L) * tt
+        for x, k in self.point_stiffness:
+            e, shape = self._shape_at(x)
+            if place[e] >= 0:
+                extra[place[e]] += k * np.outer(shape, shape)
+        return extra
 
     def _shape_at(self, x):
         """Element index and shape functions (physical DOFs) at position x."""
@@ -318,39 +358,74 @@ class Builder:
             return e, el.hermite(xi) * el.beam_dof_scaling(L)
         return e, el.linear(xi)
 
-    def _stiffness(self, rigidity: float) -> dict:
+    def _stiffness(self, rigidity: float, only=None) -> dict:
+        """Generic stiffness parameters per element (``only``: of those elements) and the
+        elements' Timoshenko g (None: Euler–Bernoulli)."""
         model = self.model
         n, L = model.elements, model.element_length
         if model.kind == "bar":
             k = np.full(n, rigidity)
-            for elements, _, w, x in _quadrature(model, self.rigidity):
+            for elements, _, w, x in _quadrature(model, self.rigidity, only):
                 k[elements] = L / np.sum(w / (rigidity * _product(self.rigidity, x)), axis=-1)
-            return {"k": k}, None
+            return {"k": k if only is None else k[only]}, None
         out = {k: np.full(n, v) for k, v in el.euler_bernoulli_stiffness(rigidity).items()}
-        for elements, s, w, x in _quadrature(model, self.rigidity):
+        for elements, s, w, x in _quadrature(model, self.rigidity, only):
             c = w / (rigidity * _product(self.rigidity, x))
             k_ww, k_wt, k_tt = el.flexibility_parameters(s, c, L)
             out["k_ww"][elements], out["k_wt"][elements], out["k_tt"][elements] = (
                 k_ww, k_wt, k_tt)
+        if only is not None:
+            out = {k: v[only] for k, v in out.items()}
         g = None
         if self.shear_rigidity is not None:
             g = el.shear_parameter(out["k_ww"] / 12.0, self.shear_rigidity, L)
             out = el.timoshenko_correction(out, g)
         return out, g
 
-    def _mass(self, E: float) -> np.ndarray:
+    def _mass(self, E: float, only=None) -> np.ndarray:
+        """Element masses in physical DOFs, point masses included (``only``: of those
+        elements)."""
         model = self.model
         n, L = model.elements, model.element_length
         rho_a = model.mass_per_length
         shape, scaling = (el.linear, np.ones(2)) if model.kind == "bar" else (
             el.hermite, el.beam_dof_scaling(L))
         mass = _uniform_mass(model.kind, n, L, rho_a, model.mass_model, E, model.inertia,
-                             model.rho, self.shear_rigidity).copy()
-        for elements, s, w, x in _quadrature(model, self.mass):
+                             model.rho, self.shear_rigidity)
+        mass = mass.copy() if only is None else mass[only]
+        place = _places(n, only)
+        for elements, s, w, x in _quadrature(model, self.mass, only):
             N = shape(s / L) * scaling
             change = rho_a * w * (_product(self.mass, x) - 1.0)
-            mass[elements] += np.swapaxes(N, -1, -2) @ (change[..., None] * N)
+            mass[place[elements]] += np.swapaxes(N, -1, -2) @ (change[..., None] * N)
+        for x, m in self.point_masses:
+            e, shape_at = self._shape_at(x)
+            if place[e] >= 0:
+                mass[place[e]] += m * np.outer(shape_at, shape_at)
         return mass
+
+
+def _places(n: int, only) -> np.ndarray:
+    """Where each of n elements sits among ``only`` (all of them: itself; -1: not there)."""
+    if only is None:
+        return np.arange(n)
+    place = np.full(n, -1)
+    place[only] = np.arange(len(only))
+    return place
+
+
+def _support_range(support, L: float, n: int) -> tuple[int, int]:
+    """The elements [lo, hi) that a factor's support (x0, x1) reaches, even in part."""
+    return max(int(np.floor(support[0] / L)), 0), min(int(np.ceil(support[1] / L)), n)
+
+
+def stiffness_elements(kind: str, params: dict, L: float) -> np.ndarray:
+    """Generic element stiffness (eq. 2, eq. 11) in physical DOFs, (n_elements, n, n)."""
+    if kind == "bar":
+        return el.generic_bar_stiffness(params["k"], L)
+    t = el.beam_dof_scaling(L)
+    ks = el.generic_beam_stiffness(params["k_ww"], params["k_wt"], params["k_tt"])
+    return ks * (t[:, None] * t[None, :]) / L**3
 
 
 @lru_cache(maxsize=64)
@@ -390,10 +465,11 @@ def _product(factors, x):
     return out
 
 
-def _quadrature(model: Model, factors):
-    """Quadrature on the elements the factors change: yields ``(elements, s, w, x)`` with
-    local coordinates s, weights w and positions x (last axis: points); elements next to a
-    breakpoint one at a time (graded points), the others together (Gauss)."""
+def _quadrature(model: Model, factors, only=None):
+    """Quadrature on the elements the factors change (``only``: of those among the given
+    ones): yields ``(elements, s, w, x)`` with local coordinates s, weights w and positions
+    x (last axis: points); elements next to a breakpoint one at a time (graded points), the
+    others together (Gauss)."""
     if not factors:
         return
     n, L = model.elements, model.element_length
@@ -402,9 +478,9 @@ def _quadrature(model: Model, factors):
         if f.support is None:
             affected[:] = True
         else:
-            lo = max(int(np.floor(f.support[0] / L)), 0)
-            hi = min(int(np.ceil(f.support[1] / L)), n)
-            affected[lo:hi] = True
+            affected[slice(*_support_range(f.support, L, n))] = True
+    if only is not None:
+        affected &= _places(n, only) >= 0
     # only an element with a kink inside needs graded points: away from it the factor is
     # smooth (a crack's exp(-|x - x_c|/ℓ) over an element of 3ℓ: Gauss-8 error ~1e-15)
     near = np.zeros(n, dtype=bool)
@@ -467,6 +543,67 @@ def free_dofs(n_dof: int, constrained: bytes) -> np.ndarray:
     free = np.setdiff1d(np.arange(n_dof), np.frombuffer(constrained, dtype=np.int64))
     free.flags.writeable = False
     return free
+
+
+#: above this many DOFs a local difference (:func:`local_difference`) is sparse
+DENSE_DIFFERENCE_DOFS = 500
+
+
+def local_difference(models, weights, index: int):
+    """Σ wᵢ K(modelsᵢ) and Σ wᵢ M(modelsᵢ) (all DOFs) of models that differ only in their
+    effect ``index`` (a fit's Jacobian differencing one variable's matrices), summed on the
+    elements that effect changes in any of them and its nodal springs: elsewhere the terms
+    are the same numbers and cancel exactly.  Dense up to :data:`DENSE_DIFFERENCE_DOFS`,
+    else sparse.  None where the difference is not local: an effect on every element (a
+    uniform factor, an element term, E), a shear beam (its g couples the sensors' reading
+    to the elements) or a plane frame."""
+    if any(m.kind not in ("beam", "bar") for m in models) or len(
+            {m.youngs_modulus for m in models}) > 1:
+        return None
+    from .effects import effect_type
+
+    builds, parts = [], []
+    for m in models:
+        effect = m.effects[index]
+        alone = Builder(m)
+        effect_type(effect.name).contribute(m, effect.parameters, alone)
+        part = alone.footprint()
+        if part is None:
+            return None
+        build = builder(m)
+        if build.shear_rigidity is not None:
+            return None
+        builds.append(build)
+        parts.append(part)
+    elements = np.unique(np.concatenate(parts)).astype(int)
+    first = models[0]
+    per = 2 if first.kind == "beam" else 1
+    n_dof = per * (first.elements + 1)
+    size = 2 * per
+    # Σ wᵢ (Aᵢ − A_last) (the weights of a derivative sum to zero), each part apart: a
+    # part the effect leaves alone (the beam's own stiffness under a point spring, a spring
+    # on a held DOF) is then exactly zero instead of rounding
+    def weighted(values):
+        return sum(w * (v - values[-1]) for w, v in zip(weights[:-1], values[:-1]))
+
+    parts = [build.element_matrices(elements) for build in builds] if elements.size else []
+    dK, dM = ((weighted([p[0] for p in parts]) + weighted([p[1] for p in parts]),
+               weighted([p[2] for p in parts])) if parts else
+              (np.zeros((0, size, size)), np.zeros((0, size, size))))
+    springs = [dict(build.nodal_springs()) for build in builds]
+    nodal = {dof: weighted([s.get(dof, 0.0) for s in springs])
+             for dof in sorted(set().union(*springs))}
+    dofs = elements[:, None] * per + np.arange(size)[None, :]
+    rows = np.concatenate([np.repeat(dofs, size, axis=1).ravel(), list(nodal)]).astype(int)
+    cols = np.concatenate([np.tile(dofs, (1, size)).ravel(), list(nodal)]).astype(int)
+    values = np.concatenate([dK.ravel(), list(nodal.values())])
+    mass_values = np.concatenate([dM.ravel(), np.zeros(len(nodal))])
+    if n_dof <= DENSE_DIFFERENCE_DOFS:
+        flat = rows * n_dof + cols
+        return tuple(np.bincount(flat, weights=v, minlength=n_dof * n_dof).reshape(n_dof, n_dof)
+                     for v in (values, mass_values))
+    return tuple(sp.csr_matrix((v, (rows, cols)), shape=(n_dof, n_dof))
+                 for v in (values, mass_values))
 
 
 def discretise(model: Model) -> Discretisation:

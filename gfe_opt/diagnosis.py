@@ -60,6 +60,7 @@ Verdict
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import functools
 import multiprocessing
@@ -688,10 +689,12 @@ def _pool_jobs(jobs, progress, labels):
     try:
         if workers < 2:
             raise OSError("one core")
-        context = multiprocessing.get_context("fork")
-        warm_solver()   # loaded once here, not once in every worker
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                                   initializer=_single_threaded_blas)
+        shared = _SHARED["depth"] > 0
+        pool = _SHARED["pool"] if shared else None
+        if pool is None:
+            pool = _new_pool(os.cpu_count() if shared else workers)
+            if shared:
+                _SHARED["pool"] = pool
         try:
             futures = {pool.submit(_job, job): i for i, job in enumerate(jobs)}
             for done, future in enumerate(as_completed(futures), start=1):
@@ -700,9 +703,11 @@ def _pool_jobs(jobs, progress, labels):
                 if progress:
                     progress(done, len(jobs), labels[futures[future]])
         except BaseException:
+            _SHARED["pool"] = None
             stop_pool(pool)
             raise
-        pool.shutdown(wait=True)
+        if not shared:
+            pool.shutdown(wait=True)
     except (OSError, ValueError, BrokenProcessPool):
         from threadpoolctl import threadpool_limits
 
@@ -714,6 +719,37 @@ def _pool_jobs(jobs, progress, labels):
                 if progress:
                     progress(i + 1, len(jobs), labels[i])
     return results
+
+
+def _new_pool(workers: int) -> ProcessPoolExecutor:
+    """Worker processes forked from this one (one BLAS thread each)."""
+    warm_solver()   # loaded once here, not once in every worker
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(
+        "fork"), initializer=_single_threaded_blas)
+
+
+#: the pool every batch of fits of the running diagnosis shares (:func:`shared_pool`)
+_SHARED = {"depth": 0, "pool": None}
+
+
+@contextlib.contextmanager
+def shared_pool():
+    """Within it, every batch of fits runs in one pool of workers, forked when the first
+    batch needs it and ended on leaving: a diagnosis runs up to six batches (the
+    candidates, a frame's members, profiles, pairs, the readings of the finding), and each
+    new pool cost its fork and, in every worker, a first fit 50 % slower than the next (the
+    copy-on-write of the parent's memory; measured on the demo beam).  The workers are
+    forked from this process as it is then: nothing that changes settings of the package
+    belongs inside."""
+    _SHARED["depth"] += 1
+    try:
+        yield
+    finally:
+        _SHARED["depth"] -= 1
+        pool, _SHARED["pool"] = (_SHARED["pool"], None) if _SHARED["depth"] == 0 else (
+            None, _SHARED["pool"])
+        if pool is not None:
+            pool.shutdown(wait=True)
 
 
 def warm_solver() -> None:
@@ -872,15 +908,10 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     frequencies alone from every start, as a pair is); None: the diagnosis decides
     (:func:`_again_thorough`)."""
     start = time.perf_counter()
-    reuse, names = {}, tuple(thorough or ())
-    result = _diagnose(model, measured, candidates, freq_noise, shape_noise, progress,
-                       realise, names, reuse)
-    again = _again_thorough(result, measured) if thorough is None else ()
+    with shared_pool():
+        result, names, second, again = _passes(model, measured, candidates, freq_noise,
+                                               shape_noise, progress, realise, thorough)
     if again:
-        # the fits the first pass made alike (the other candidates, the present effects
-        # taken out, the generic update) are its own, copied before it judged them
-        second = _diagnose(model, measured, candidates, freq_noise, shape_noise, progress,
-                           realise, again, reuse)
         # it stands only where it names what explains the difference to the noise: a
         # partial finding from another valley is no reason to withdraw "unexplained" (a
         # taper beside two cracks: a zone from another valley then tied a pair with the
@@ -896,6 +927,24 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     result.thorough = names
     result.seconds = time.perf_counter() - start
     return result
+
+
+def _passes(model, measured, candidates, freq_noise, shape_noise, progress, realise,
+            thorough):
+    """The diagnosis's first pass and, where it asks for one (:func:`_again_thorough`),
+    its second: (first, the names fitted from every valley, second or None, the names the
+    second pass fitted again)."""
+    reuse, names = {}, tuple(thorough or ())
+    result = _diagnose(model, measured, candidates, freq_noise, shape_noise, progress,
+                       realise, names, reuse)
+    again = _again_thorough(result, measured) if thorough is None else ()
+    second = None
+    if again:
+        # the fits the first pass made alike (the other candidates, the present effects
+        # taken out, the generic update) are its own, copied before it judged them
+        second = _diagnose(model, measured, candidates, freq_noise, shape_noise, progress,
+                           realise, again, reuse)
+    return result, names, second, again
 
 
 def _again_thorough(result, measured) -> tuple:

@@ -51,7 +51,7 @@ from scipy.linalg import block_diag
 from scipy.special import chdtri
 
 from . import names
-from .assembly import discretise
+from .assembly import discretise, local_difference
 from .correlation import mac, pair_by_frequency, pair_modes
 from .effects import EffectType, effect_type
 from .errors import GfeInputError, GfeSolverError
@@ -218,17 +218,20 @@ def point_of(disc, K, M, modes, measured, noise: Noise, C=None) -> Point:
 
 
 def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upper,
-                   step: float = 1e-5, columns=None) -> np.ndarray:
+                   step: float = 1e-5, columns=None, owner=None) -> np.ndarray:
     """The Jacobian of the residual at ``point`` (the evaluation at z) with respect to z,
     the pairing held: eigenvalue and eigenvector derivatives
     (:func:`~gfe_opt.sensitivity.eigen_derivatives`) with ∂K, ∂M (and, for a shear beam,
     the observation's ∂C) from second-order differences of the *matrices* of
     ``model_at(z)`` (central; at a bound one-sided three-point, stepping inwards), no
-    modal solve besides the one of ``point``.  Raises ``ValueError`` where the modes have no
-    derivative (a repeated or zero eigenvalue among the paired ones).  ``columns``: only
-    those columns are wanted (the others come out zero): the matrices of the other
-    variables are not built, and the eigen-derivatives still solve for every column (zero
-    ones there), so each wanted column is the full Jacobian's to the last bit."""
+    modal solve besides the one of ``point``.  ``owner``: per variable, the index of the
+    effect of ``model_at(z)`` it moves; the matrices are then differenced on the elements
+    that effect changes (:func:`~gfe_opt.assembly.local_difference`) where it changes few.
+    Raises ``ValueError`` where the modes have no derivative (a repeated or zero eigenvalue
+    among the paired ones).  ``columns``: only those columns are wanted (the others come
+    out zero): the matrices of the other variables are not built, and the
+    eigen-derivatives still solve for every column (zero ones there), so each wanted
+    column is the full Jacobian's to the last bit."""
     from .sensitivity import eigen_derivatives
 
     n = z.size
@@ -238,6 +241,14 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
         disc = discretise(model_at(zz))
         K, M = disc.global_matrices()
         return K, M, (observation(disc, measured) if shear else None)
+
+    def local(k, points, weights):
+        """The weighted sum of the matrices at ``points`` from the elements variable k's
+        effect changes (None: not local)."""
+        if owner is None or shear:
+            return None
+        part = local_difference([model_at(zz) for zz in points], weights, owner[k])
+        return None if part is None else (*part, None)
 
     dK, dM, dC = [], [], []
     wanted = range(n) if columns is None else set(int(k) for k in columns)
@@ -254,16 +265,20 @@ def point_jacobian(point: Point, z, model_at, measured, noise: Noise, lower, upp
         if z[k] + h <= upper[k] and z[k] - h >= lower[k]:
             up[k] += h
             down[k] -= h
-            a, b = matrices(up), matrices(down)
-            diff = [(x - y) / (2 * h) if x is not None else None for x, y in zip(a, b)]
+            diff = local(k, (up, down), (1 / (2 * h), -1 / (2 * h)))
+            if diff is None:
+                a, b = matrices(up), matrices(down)
+                diff = [(x - y) / (2 * h) if x is not None else None for x, y in zip(a, b)]
         else:
             h = h if z[k] + 2 * h <= upper[k] else -h
             up[k] += h
             down[k] += 2 * h
-            here = (point.K, point.M, point.C if shear else None)
-            a, b = matrices(up), matrices(down)
-            diff = [(4 * x - y - 3 * c) / (2 * h) if x is not None else None
-                    for x, y, c in zip(a, b, here)]
+            diff = local(k, (up, down, z), (4 / (2 * h), -1 / (2 * h), -3 / (2 * h)))
+            if diff is None:
+                here = (point.K, point.M, point.C if shear else None)
+                a, b = matrices(up), matrices(down)
+                diff = [(4 * x - y - 3 * c) / (2 * h) if x is not None else None
+                        for x, y, c in zip(a, b, here)]
         dK.append(diff[0])
         dM.append(diff[1])
         dC.append(diff[2])
@@ -498,8 +513,10 @@ class Objective:
     (:func:`point_jacobian`, falling back to differences of r where the modes have no
     derivative), None when fits difference the residual itself."""
 
-    def __init__(self, model_at, measured, noise, C, analytic: bool = True):
+    def __init__(self, model_at, measured, noise, C, analytic: bool = True, owner=None):
         self.model_at, self.measured, self.noise, self.C = model_at, measured, noise, C
+        #: per variable, the index of the effect of ``model_at(z)`` it moves
+        self.owner = owner
         self.count = 0
         self.fallbacks = 0
         self._last = None
@@ -531,7 +548,7 @@ class Objective:
             try:
                 return point_jacobian(point, np.asarray(z, dtype=float), self.model_at,
                                       self.measured, self.noise, lower, upper,
-                                      columns=columns)
+                                      columns=columns, owner=self.owner)
             except _TRIAL_ERRORS:
                 pass
         self.fallbacks += 1
@@ -642,7 +659,7 @@ def fit_problem(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     analytic = (jacobian or JACOBIAN) == "analytic" and not condensed(base)
     problem.residual = Objective(
         lambda z: base.with_effects(problem.effects_of(z), check=False), measured, noise, C,
-        analytic)
+        analytic, owner=[j for j, s in enumerate(slots) for _ in s.variables])
     return problem
 
 
@@ -991,8 +1008,12 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
         g = Ju.T @ r
         held = (((z - lower) <= 1e-12 * span) & (g > 0)) | (((upper - z) <= 1e-12 * span)
                                                             & (g < 0))
-        free = ~held & (np.linalg.norm(Ju, axis=0) > 0)
         floor = max(1.0, value / max(r.size - n, 1))
+        # a variable that cannot change χ² by the stopping rule's amount over its whole
+        # range (linearised: 2|r||J_k| span + (|J_k| span)²) takes no part: its column,
+        # scaled to unit length, would carry only its rounding (a spring on a held DOF)
+        reach = np.linalg.norm(J, axis=0) * span
+        free = ~held & (2 * np.linalg.norm(r) * reach + reach**2 > FINISH_DECREMENT * floor)
         if not free.any():
             return z, value, 0.0
         Jf = Ju[:, free]
