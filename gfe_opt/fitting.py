@@ -520,6 +520,7 @@ class Objective:
         self.count = 0
         self.fallbacks = 0
         self._last = None
+        self._last_jacobian = None
         self.jacobian = self._analytic if analytic else None
 
     def point(self, z) -> Point | None:
@@ -543,16 +544,28 @@ class Objective:
         return np.full(self.measured.n_values, FAILED_RESIDUAL) if point is None else point.r
 
     def _analytic(self, z, r, lower, upper, columns=None) -> np.ndarray:
+        z = np.asarray(z, dtype=float)
+        # the last one kept (read-only): a fit's σ asks again at the point its finish
+        # ended on
+        key = (z.tobytes(), None if columns is None else tuple(int(k) for k in columns),
+               np.asarray(lower, dtype=float).tobytes(),
+               np.asarray(upper, dtype=float).tobytes())
+        if self._last_jacobian is not None and self._last_jacobian[0] == key:
+            return self._last_jacobian[1]
+        J = None
         point = self.point(z)
         if point is not None:
             try:
-                return point_jacobian(point, np.asarray(z, dtype=float), self.model_at,
-                                      self.measured, self.noise, lower, upper,
-                                      columns=columns, owner=self.owner)
+                J = point_jacobian(point, z, self.model_at, self.measured, self.noise, lower,
+                                   upper, columns=columns, owner=self.owner)
             except _TRIAL_ERRORS:
                 pass
-        self.fallbacks += 1
-        return _difference_jacobian(self, z, r, lower, upper)
+        if J is None:
+            self.fallbacks += 1
+            J = _difference_jacobian(self, z, r, lower, upper)
+        J.flags.writeable = False
+        self._last_jacobian = (key, J)
+        return J
 
 
 @dataclass
