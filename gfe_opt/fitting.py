@@ -1063,6 +1063,10 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
             if trial_value < value:
                 accepted = True
                 break
+            if -(2 * gk @ w + w @ H @ w) < FINISH_DECREMENT * floor:
+                # it failed, and predicted less than the rule's amount: more damping only
+                # predicts less (the tail of a fit whose χ² has stopped falling to rounding)
+                break
             lam = 1e-6 if lam == 0.0 else lam * 10.0
         if not accepted and np.any(S):
             # no step lowers χ² with the secant term built up along the way (from a start far
