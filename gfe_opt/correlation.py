@@ -126,43 +126,31 @@ def expand_modes(disc: Discretisation, C, omega, shapes, noise: float = DEFAULT_
     out_shapes = np.zeros((n_dof, len(omega)))
     forces = np.zeros((C.shape[0], len(omega)))
     rel = np.zeros_like(forces)
+    few = Cf.shape[0] <= DENSE_SENSOR_LIMIT
     # a small model with few sensors: dense LAPACK (a sparse factorisation's set-up costs
     # more than a dense one of a few hundred DOFs)
-    dense = noise > 0 and free.size <= DENSE_EXPANSION_DOFS and \
-        Cf.shape[0] <= DENSE_SENSOR_LIMIT
+    dense = noise > 0 and few and free.size <= DENSE_EXPANSION_DOFS
     if dense:
         Kd, Md, CdT = Kf.toarray(), Mf.toarray(), Cf.T.toarray()
     for j, w in enumerate(omega):
         y = shapes[:, j]
-        if dense:
-            X = _dense_receptance(Kd, Md, w, CdT)   # D^-1 C^T, (n_free, n_sensors)
-            G = Cf @ X
-            G = 0.5 * (G + G.T)
-            lam = _tikhonov_discrepancy(G, y, noise)
-            phi = X @ lam
-            out_shapes[free, j] = phi
-            inertia = np.linalg.norm(w**2 * (Mf @ phi))
-            forces[:, j] = lam
-            rel[:, j] = np.abs(lam) / inertia if inertia > 0 else np.inf
-            continue
-        D = (Kf - w**2 * Mf).tocsc()
         if noise <= 0:
             # exact data: the sparse saddle-point system [[D, -Cᵀ], [C, 0]] [φ; λ] = [0; y]
             # (Kidder's expansion, O(n) work for any number of sensors)
+            D = (Kf - w**2 * Mf).tocsc()
             saddle = sp.bmat([[D, -Cf.T], [Cf, None]]).tocsc()
             sol = spla.splu(saddle).solve(np.concatenate([np.zeros(D.shape[0]), y]))
             phi, lam = sol[:D.shape[0]], sol[D.shape[0]:]
+        elif dense:
+            phi, lam = _tikhonov_receptance(Cf, _dense_receptance(Kd, Md, w, CdT), y, noise)
         else:
+            D = (Kf - w**2 * Mf).tocsc()
             try:
                 lu = spla.splu(D)
             except RuntimeError:  # ω is exactly a model eigenvalue: nudge it
                 lu = spla.splu((Kf - (w * (1 + 1e-9)) ** 2 * Mf).tocsc())
-            if Cf.shape[0] <= DENSE_SENSOR_LIMIT:
-                X = lu.solve(Cf.T.toarray())  # D^-1 C^T, (n_free, n_sensors)
-                G = Cf @ X
-                G = 0.5 * (G + G.T)
-                lam = _tikhonov_discrepancy(G, y, noise)
-                phi = X @ lam
+            if few:
+                phi, lam = _tikhonov_receptance(Cf, lu.solve(Cf.T.toarray()), y, noise)
             elif Cf.shape[0] * Cf.shape[1] <= LOW_RANK_LIMIT:
                 # many sensors on a coarse model: G has rank <= n_free, solved in that space
                 phi, lam = _tikhonov_low_rank(lu, Cf, y, noise)
@@ -181,6 +169,14 @@ DENSE_SENSOR_LIMIT = 200
 #: up to this many free DOFs (and DENSE_SENSOR_LIMIT sensors) the expansion factors
 #: K − ω²M dense (the 46-element demo beam: 0.3 against 0.75 ms a mode)
 DENSE_EXPANSION_DOFS = 400
+
+
+def _tikhonov_receptance(C, X, y, noise):
+    """(φ, λ) of the Tikhonov expansion (:func:`_tikhonov_discrepancy`) from X = D⁻¹Cᵀ
+    (n_free, n_sensors): G = C X, symmetric but for rounding, and φ = X λ."""
+    G = C @ X
+    lam = _tikhonov_discrepancy(0.5 * (G + G.T), y, noise)
+    return X @ lam, lam
 
 
 def _dense_receptance(K, M, w, CT):
