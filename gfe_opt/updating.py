@@ -725,9 +725,12 @@ def _condition_rows(pb: _Problem):
     return (sp.csr_matrix(pb.par.matrix) @ sp.diags(pb.x_scale[:pb.n_q]) / pb.k0).tocsr()
 
 
-def _condition_values(p, n: int, kind: str):
-    """The conditions of :func:`_constraints` from the scaled element parameters ``p``
-    (numbers or CasADi expressions, the blocks of :func:`_condition_rows`)."""
+def _condition_values(p, n: int, kind: str) -> list:
+    """The element conditions (each ≥ the margin) from the element parameters ``p`` scaled
+    by k0 (numbers or CasADi expressions; blocks of ``n`` elements as
+    :func:`_condition_rows` orders them): a bar's k; a beam's k_ww, k_θθ and
+    k_ww k_θθ - k_wθ²; a frame member's those and its bar's k.  The one place of these
+    formulas (:func:`_constraints`, :func:`_solve_reduced`)."""
     if kind == "bar":
         return [p]
     ww, wt, tt = p[:n], p[n:2 * n], p[2 * n:3 * n]
@@ -869,14 +872,7 @@ def _constraints(pb: _Problem, x):
     numeric = isinstance(x, np.ndarray)
     p = (pb.par.matrix @ x[:pb.n_q] if numeric
          else ca.mtimes(_dm(pb.par.matrix), x[:pb.n_q])) / pb.k0
-    n = pb.par.n_elements
-    if pb.disc.kind == "bar":
-        g = [p]
-    else:
-        ww, wt, tt = p[:n], p[n:2 * n], p[2 * n:3 * n]
-        g = [ww, tt, ww * tt - wt**2]
-        if pb.disc.kind == "frame":   # a frame's members: the bar's k too
-            g.append(p[3 * n:])
+    g = _condition_values(p, pb.par.n_elements, pb.disc.kind)
     lower = [np.full(sum(e.shape[0] for e in g), pb.margin)]
     if pb.mmap is not None:
         mass = pb.mmap.conditions(x[pb.n_q:])

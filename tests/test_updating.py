@@ -107,32 +107,45 @@ def test_ipopt_direct_and_sdp_agree_on_a_convex_instance(weighting):
         assert check["active_ipopt"] == check["active_sdp"] == []
 
 
-def _conic_step(model, measured, shapes, margin):
+def _conic_step(model, measured, shapes, margin, parameterisation):
     """The convex step of ``update_generic(..., full_shapes=shapes)`` solved by another
-    method: cvxpy/Clarabel, k_ww k_θθ - k_wθ² ≥ m as the second-order cone k_ww + k_θθ ≥
-    ||(k_ww - k_θθ, 2 k_wθ, 2√m)|| (scaled by k0), the objective ||B z + b||² + ||V (z -
-    z0)||² and the energy balance from the update's own problem data."""
+    method, cvxpy/Clarabel: the objective ||B z + b||² + ||V (z - z0)||² and the energy
+    balance from the update's own problem data; a bar's k ≥ m, a beam's k_ww, k_θθ ≥ m and
+    k_ww k_θθ - k_wθ² ≥ m as the second-order cone k_ww + k_θθ ≥ ||(k_ww - k_θθ, 2 k_wθ,
+    2√m)|| (all scaled by k0).  Returns (x, the scaled element parameters, the objective
+    as a function of x)."""
     import cvxpy as cp
 
     from gfe_opt import updating
 
     disc = discretise(model)
-    par = beam_parameterisation("nodal", model.elements, model.element_length)
+    par = parameterisation
     pb = updating._prepare(disc, par, measured, 0.0, updating.default_regularisation(True),
                            margin, par.fit(disc.stiffness_params), shapes)
     B, b, reg = updating._expanded_least_squares(pb)
     E, c = updating._energy_balance(pb)
     z = cp.Variable(pb.x0.size)
-    p = (par.matrix @ np.diag(pb.x_scale) / pb.k0) @ z
-    n = par.n_elements
-    ww, wt, tt = p[:n], p[n:2 * n], p[2 * n:]
-    cones = [cp.SOC(ww[i] + tt[i], cp.hstack([ww[i] - tt[i], 2 * wt[i], 2 * np.sqrt(margin)]))
-             for i in range(n)]
-    problem = cp.Problem(cp.Minimize(cp.sum_squares(B @ z + b)
-                                     + cp.sum_squares(cp.multiply(reg, z - pb.x0 / pb.x_scale))),
-                         [ww >= margin, tt >= margin, (E * pb.x_scale) @ z + c == 0] + cones)
-    problem.solve(solver="CLARABEL", tol_gap_abs=1e-12, tol_gap_rel=1e-12, tol_feas=1e-12)
-    return pb.x_scale * z.value
+    P = par.matrix @ np.diag(pb.x_scale) / pb.k0
+    p = P @ z
+    constraints = [(E * pb.x_scale) @ z + c == 0]
+    if model.kind == "bar":
+        constraints.append(p >= margin)
+    else:
+        n = par.n_elements
+        ww, wt, tt = p[:n], p[n:2 * n], p[2 * n:]
+        constraints += [ww >= margin, tt >= margin] + [
+            cp.SOC(ww[i] + tt[i], cp.hstack([ww[i] - tt[i], 2 * wt[i], 2 * np.sqrt(margin)]))
+            for i in range(n)]
+    cp.Problem(cp.Minimize(cp.sum_squares(B @ z + b)
+                           + cp.sum_squares(cp.multiply(reg, z - pb.x0 / pb.x_scale))),
+               constraints).solve(solver="CLARABEL", tol_gap_abs=1e-12, tol_gap_rel=1e-12,
+                                  tol_feas=1e-12)
+
+    def objective(x):
+        y = x / pb.x_scale
+        return np.sum((B @ y + b) ** 2) + np.sum((reg * (y - pb.x0 / pb.x_scale)) ** 2)
+
+    return pb.x_scale * z.value, P @ z.value, objective
 
 
 def test_active_constraint_is_solved_on_the_reduced_problem():
@@ -151,7 +164,7 @@ def test_active_constraint_is_solved_on_the_reduced_problem():
     assert auto.stats["steps"] == ["reduced"] and auto.solver == "ipopt", auto.summary()
     assert auto.ok and not auto.violations
     assert active_constraints(auto) == active_constraints(forced) != []
-    conic = _conic_step(model, measured, shapes, 3.5)
+    conic, _, _ = _conic_step(model, measured, shapes, 3.5, auto.parameterisation)
     scale = np.max(np.abs(conic))
     assert np.max(np.abs(auto.q - conic)) < 1e-7 * scale        # measured 7.3e-9
     assert np.max(np.abs(auto.q - forced.q)) < 1e-5 * scale     # measured 2.4e-7
@@ -168,32 +181,13 @@ def test_reduced_step_frees_the_neighbours_a_binding_condition_pushes_on():
     # bound set and objective; the parameters agree to 4.4e-5 of the largest, along a
     # direction whose curvature is 5e-9 of the largest (the reduced problem holds its bounds
     # 1e-9 above the margin, which that direction amplifies)
-    import cvxpy as cp
-
-    from gfe_opt import updating
-
     bar = make_model(STEEL_BAR, elements=40)
     measured, shapes = _exact_bar_modes(bar, 3)
     auto = update_generic(bar, measured, full_shapes=shapes, noise=0.0, margin=0.99)
     assert auto.stats["steps"] == ["reduced"] and auto.ok and not auto.violations
-    pb = updating._prepare(discretise(bar), auto.parameterisation, measured, 0.0,
-                           updating.default_regularisation(True), 0.99, auto.q0, shapes)
-    B, b, reg = updating._expanded_least_squares(pb)
-    E, c = updating._energy_balance(pb)
-    z = cp.Variable(pb.x0.size)
-    P = auto.parameterisation.matrix @ np.diag(pb.x_scale) / pb.k0
-    cp.Problem(cp.Minimize(cp.sum_squares(B @ z + b)
-                           + cp.sum_squares(cp.multiply(reg, z - pb.x0 / pb.x_scale))),
-               [P @ z >= 0.99, (E * pb.x_scale) @ z + c == 0]).solve(
-        solver="CLARABEL", tol_gap_abs=1e-12, tol_gap_rel=1e-12, tol_feas=1e-12)
-    qp = pb.x_scale * z.value
-
-    def objective(x):
-        y = x / pb.x_scale
-        return np.sum((B @ y + b) ** 2) + np.sum((reg * (y - pb.x0 / pb.x_scale)) ** 2)
-
+    qp, p, objective = _conic_step(bar, measured, shapes, 0.99, auto.parameterisation)
     held = np.flatnonzero(auto.element_parameters["k"] / auto.k0 - 0.99 < 1e-7)
-    assert held.tolist() == np.flatnonzero(P @ z.value - 0.99 < 1e-7).tolist()
+    assert held.tolist() == np.flatnonzero(p - 0.99 < 1e-7).tolist()
     assert held.size == 7
     assert abs(objective(auto.q) / objective(qp) - 1) < 1e-6        # measured 1.1e-7
     assert np.max(np.abs(auto.q - qp)) < 1e-3 * np.max(np.abs(qp))   # measured 4.4e-5
