@@ -669,10 +669,9 @@ class _Kkt:
         return col, self.lu.solve(col)
 
     def solve(self, columns=(), values=()):
-        """(x, relative residual, multipliers of the extra rows) of the equality problem
-        bordered by :meth:`column` pairs ``columns`` held at ``values`` (F z = f), or None
-        when it is singular or stays inaccurate.  The multiplier λ of a row enters as
-        ∇J + λ Fᵀ = 0: a row held as F z ≥ f binds when λ ≤ 0."""
+        """(x, relative residual) of the equality problem bordered by :meth:`column` pairs
+        ``columns`` held at ``values`` (F z = f), or None when it is singular or stays
+        inaccurate."""
         border, k_border, rhs_eq = self.border, self.k_border, self.rhs_eq
         if len(columns):
             border = np.hstack([border, np.stack([c for c, _ in columns], 1)])
@@ -704,7 +703,7 @@ class _Kkt:
                          / max(scale, 1e-300))
         if not np.all(np.isfinite(y)) or residual > 1e-8:
             return None
-        return self.x_scale * y[self.n_u:], residual, lam[self.border.shape[1]:]
+        return self.x_scale * y[self.n_u:], residual
 
 
 def _solve_direct(pb: _Problem):
@@ -716,7 +715,7 @@ def _solve_direct(pb: _Problem):
     except RuntimeError:  # an exactly singular pivot (no regularisation)
         return None
     out = kkt.solve()
-    return None if out is None else (kkt, out[0], out[1])
+    return None if out is None else (kkt, *out)
 
 
 def _condition_rows(pb: _Problem):
