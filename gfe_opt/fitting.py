@@ -959,6 +959,8 @@ NEWTON_STEPS = 100
 #: are not determined by the data: their σ is 10⁴ times the best-determined one's (a zone at
 #: a clamp whose centre and length trade exactly shows 1e-6)
 FINISH_RANK = 1e-4
+#: a finish stops after this many steps in a row pinned against a seam of χ² (:func:`_finish`)
+PINNED_STEPS = int(os.environ.get("GFE_OPT_PINNED", "2"))
 #: finish outcomes (and IPOPT statuses where it runs) of this process's fits (tests count
 #: them)
 SOLVER_TALLY: Counter = Counter()
@@ -1027,7 +1029,7 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     value = float(r @ r)
     if n == 0 or not np.isfinite(value) or value >= FAILED_RESIDUAL**2:
         return z, value, 0.0 if n == 0 else np.inf
-    pairing = _pairing(residual)
+    pairing, pinned = _pairing(residual), 0
     J = _jacobian(residual, z, r, lower, upper)
     d = np.linalg.norm(J, axis=0)
     d = np.where(d > 0, d, 1.0)   # fixed scaling: u = d z
@@ -1099,7 +1101,9 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
             continue
         if not accepted:  # no step lowers χ²: the optimum as far as rounding can tell
             return z, value, decrement / floor
-        if seams and not others and value - trial_value < FINISH_SETTLED * floor:
+        pinned = pinned + 1 if (seams and not others
+                                and value - trial_value < FINISH_SETTLED * floor) else 0
+        if pinned >= PINNED_STEPS:
             # pinned against a seam (docstring): creeping on would not change the outcome
             return trial, trial_value, decrement / floor
         pairing = trial_pairing
