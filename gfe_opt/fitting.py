@@ -960,7 +960,7 @@ NEWTON_STEPS = 100
 #: a clamp whose centre and length trade exactly shows 1e-6)
 FINISH_RANK = 1e-4
 #: a finish stops after this many steps in a row pinned against a seam of χ² (:func:`_finish`)
-PINNED_STEPS = int(os.environ.get("GFE_OPT_PINNED", "2"))
+PINNED_STEPS = 2
 #: finish outcomes (and IPOPT statuses where it runs) of this process's fits (tests count
 #: them)
 SOLVER_TALLY: Counter = Counter()
@@ -1015,15 +1015,16 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     length trade exactly); their σ says so.
 
     A fit pinned against a seam of χ² (a measured mode that pairs no model mode past it:
-    χ² jumps there) stops: where every trial a step rejected paired the modes otherwise
-    than the point it left, and the step it took then gained less than
-    :data:`FINISH_SETTLED` noise floors, the steps only creep on towards the seam, a tenth
-    of the gain every few steps while the Newton decrement, which looks past the seam,
-    stays high: an end that is ``not_converged`` either way (on the three-storey frame's
-    diagnosis such creeps took 900 of its 1 471 Jacobians; the fits that crossed a seam and
-    converged gained seven times that amount or more on every such step).  Returns (z, χ²,
-    the last decrement in noise floors: 0 when nothing was left to fit, inf when the fit
-    could not be evaluated)."""
+    χ² jumps there) stops: where, on :data:`PINNED_STEPS` steps in a row, every trial the
+    step rejected paired the modes otherwise than the point it left and the step it took
+    then gained less than :data:`FINISH_SETTLED` noise floors, the steps only creep on
+    towards the seam, a tenth of the gain every few steps while the Newton decrement,
+    which looks past the seam, stays high: an end that is ``not_converged`` either way (on
+    the three-storey frame's diagnosis such creeps took 900 of its 1 471 Jacobians).  One
+    such step is not enough: after many rejections one small step, then steps that gain
+    again, is how three of the semi-rigid portal's fits leave a seam and converge.  Returns
+    (z, χ², the last decrement in noise floors: 0 when nothing was left to fit, inf when the
+    fit could not be evaluated)."""
     n = z.size
     r = residual(z)
     value = float(r @ r)
