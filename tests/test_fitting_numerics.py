@@ -282,6 +282,7 @@ class _Seamed:
     def __init__(self, seam, best, curved=False, scale=30.0, n=40):
         self.seam, self.best, self.scale, self.n, self.curved = seam, best, scale, n, curved
         self.count, self._side = 0, None
+        self.crossed = 0           # evaluations past the seam
         self._t = np.linspace(0.0, 1.0, n)
 
     def __call__(self, z):
@@ -290,7 +291,7 @@ class _Seamed:
         d = np.expm1(x - self.best) if self.curved else x - self.best
         r = self.scale * d * (1.0 + 0.3 * self._t) + 0.5 * np.sin(7 * self._t)
         self._side = x > self.seam
-        self.crossed = getattr(self, "crossed", 0) + int(self._side)
+        self.crossed += int(self._side)
         if self._side:
             r = r.copy()
             r[0] = 1000.0          # the unpaired mode's residual: χ² jumps up by ~1e6
