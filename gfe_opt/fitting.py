@@ -1124,19 +1124,15 @@ def _pairing(residual):
 
 def _secant(S, s, J_old, J_new, r_new, g_old):
     """Dennis–Gay–Welsch update of the second-order term S ≈ Σ rᵢ∇²rᵢ from a step s (scaled
-    variables): S s should match y♯ = (J_new − J_old)ᵀ r_new; sized down first as in NL2SOL,
-    also where the step shows no positive curvature (yᵀs ≤ 0) and the update itself is
-    skipped: else an S learnt far away stays whole (a spring that fell to its bound left
-    the S of its stiff start on its place, 5·10⁷ times the place's JᵀJ, and 100 steps crept
-    0.14 along it on the three-storey frame)."""
+    variables): S s should match y♯ = (J_new − J_old)ᵀ r_new; sized down first as in NL2SOL."""
     y_sharp = (J_new - J_old).T @ r_new
     y = J_new.T @ r_new - g_old
     ys = float(y @ s)
+    if ys <= 1e-300 * max(float(s @ s), 1e-300):
+        return S
     sSs = float(s @ S @ s)
     if sSs != 0.0:
         S = S * min(1.0, abs(float(s @ y_sharp)) / abs(sSs))
-    if ys <= 1e-300 * max(float(s @ s), 1e-300):
-        return S
     e = y_sharp - S @ s
     return S + (np.outer(e, y) + np.outer(y, e)) / ys - float(e @ s) * np.outer(y, y) / ys**2
 
