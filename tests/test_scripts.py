@@ -138,3 +138,53 @@ def test_the_frame_campaign_builds_every_class_from_the_exact_frame():
             assert shift < 4 * noise, (group, shift, noise)
         else:   # a brace's weakest pull (20 N) moves its modes by a few noise levels only
             assert shift > (2 if group == "tension" else 4) * noise, (group, shift, noise)
+
+
+def test_following_the_finishes_changes_no_fit_and_records_what_they_reached():
+    """scripts/bench_fit_relevance.py's --campaign follows every Newton finish through a
+    proxy of its residual: the diagnosis is the same to the last bit as without it, each
+    finish's χ² after k Jacobians is the lowest it had evaluated by then (never below its
+    end, never rising with k), and the rule's tally counts what it is defined to."""
+    sys.path.insert(0, str(SCRIPTS))
+    try:
+        import bench_fit_relevance as relevance
+    finally:
+        sys.path.remove(str(SCRIPTS))
+    from gfe_opt import diagnosis
+    from gfe_opt.model import Effect, load_model
+    from gfe_opt.problems import problem_file
+    from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+
+    model = load_model(problem_file("ss-steel-beam.toml")).with_elements(20)
+    truth = model.with_effects([Effect("point_mass", {"position": 0.31, "mass": 0.05})])
+    measured = synthetic_measurement(truth, 4, interior_sensors(model.length, 12),
+                                     shape_noise=0.003, freq_noise=0.0005, seed=7,
+                                     reference_elements=80)
+    noise = {"freq_noise": 0.0005, "shape_noise": 0.003}
+    serial, diagnosis.SERIAL_FITS = diagnosis.SERIAL_FITS, True
+    try:
+        plain = diagnosis.diagnose(model, measured, **noise)
+        followed, finishes = relevance._followed_finishes(
+            lambda: diagnosis.diagnose(model, measured, **noise))
+    finally:
+        diagnosis.SERIAL_FITS = serial
+    assert followed.verdict == plain.verdict
+    assert [f.misfit.chi2 for f in followed.fits] == [f.misfit.chi2 for f in plain.fits]
+    assert len(finishes) >= len(plain.fits) and sum(f["jacobians"] for f in finishes) > 0
+    for f in finishes:
+        reached = [f["after"][k] for k in relevance.AFTER]
+        assert all(a >= b for a, b in zip(reached, reached[1:]))
+        assert reached[-1] >= f["end"] * (1 - 1e-12)
+    # the rule: after 2 Jacobians, cut what is above F times the lowest then
+    rows = [{"name": "a", "finishes": [
+        {"after": {k: v for k in relevance.AFTER}, "end": end, "jacobians": n}
+        for v, end, n in ((10.0, 9.0, 6), (500.0, 400.0, 9), (2000.0, 50.0, 12),
+                          (20000.0, 19000.0, 2))]}]
+    rules = {(r["after_jacobians"], r["F"]): r for r in relevance._rules(rows, 100.0)}
+    # (the best end is 9: a finish ending at or below 100 x 9 is a contender)
+    r = rules[(2, 100.0)]   # only 2000 is above 100 x 10 (20000's finish ended after 2)
+    assert (r["finishes_cut"], r["jacobians_saved"], r["cut_contenders"]) == (1, 10, 1)
+    assert r["jacobians_total"] == 6 + 9 + 12 + 2
+    r = rules[(1, 10.0)]    # 500, 2000 and 20000 cut; 500 and 2000 end as contenders
+    assert (r["finishes_cut"], r["jacobians_saved"], r["cut_contenders"]) == (3, 8 + 11 + 1,
+                                                                              2)
