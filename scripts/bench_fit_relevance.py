@@ -220,7 +220,7 @@ def main(argv=None) -> int:
     grid_start, fit_group = fitting._grid_start, diagnosis._fit_group
     grid = []
 
-    def recording_grid(chi2, grids, nulls=None, bulk=None):
+    def recording_grid(chi2, grids, nulls=None, bulk=None, **kwargs):
         def seen(z):
             value = chi2(z)
             grid.append(value)
@@ -231,7 +231,8 @@ def main(argv=None) -> int:
             if values is not None:
                 grid.extend(values)
             return values
-        return grid_start(seen, grids, nulls, None if bulk is None else seen_in_bulk)
+        return grid_start(seen, grids, nulls, None if bulk is None else seen_in_bulk,
+                          **kwargs)
 
     rows = []
 
