@@ -1022,11 +1022,7 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     which looks past the seam, stays high: an end that is ``not_converged`` either way (on
     the three-storey frame's diagnosis such creeps took 900 of its 1 471 Jacobians).  One
     such step is not enough: after many rejections one small step, then steps that gain
-    again, is how three of the semi-rigid portal's fits leave a seam and converge.  A step
-    that gained less than :data:`FINISH_SETTLED` of what Gauss–Newton predicts at its start
-    (and of a floor) drops S: the secant term learnt elsewhere held it to a creep (a spring
-    whose first step took it to its bound kept the S of its stiff start, and crept 100
-    steps), and the next step is Gauss–Newton's.  Returns
+    again, is how three of the semi-rigid portal's fits leave a seam and converge.  Returns
     (z, χ², the last decrement in noise floors: 0 when nothing was left to fit, inf when the
     fit could not be evaluated)."""
     n = z.size
