@@ -1110,14 +1110,7 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
         pairing = trial_pairing
         lam = 0.0 if lam <= 1e-6 else lam / 10.0
         J_new = _jacobian(residual, trial, r_trial, lower, upper)
-        if np.any(S) and value - trial_value < FINISH_SETTLED * min(floor, ur @ ur):
-            # the secant term held the step to a creep: it gained less than FINISH_SETTLED
-            # of what Gauss–Newton predicts here (and of a floor); S learnt elsewhere (a
-            # spring's stiff start, before it fell to its bound, left S 5·10⁷ times JᵀJ
-            # along its place, and 100 steps crept 0.07 along it): Gauss–Newton again
-            S = np.zeros((n, n))
-        else:
-            S = _secant(S, (trial - z) * d, J / d, J_new / d, r_trial, g)
+        S = _secant(S, (trial - z) * d, J / d, J_new / d, r_trial, g)
         z, r, value, J = trial, r_trial, trial_value, J_new
     return z, value, decrement / floor
 
