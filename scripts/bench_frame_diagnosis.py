@@ -404,6 +404,14 @@ def frequencies_only(case: dict) -> dict:
     return {**case, "measured": replace(m, sensors=[], shapes=None)}
 
 
+def case_seeds(seed: int, cases: int, chosen=CLASSES) -> list:
+    """(seed, class) of each case of a campaign of ``cases`` a class, in the order run: the
+    first ten classes' seeds seed + 10 i + j, the others' from seed + 1000 (a class keeps
+    its seeds whichever classes run)."""
+    return [(seed + 10 * i + j if j < 10 else seed + 1000 + 10 * i + j - 10, g)
+            for i in range(cases) for j, g in enumerate(CLASSES) if g in chosen]
+
+
 def run_case(case: dict) -> dict:
     model, measured, noise = case["model"], case["measured"], case["noise"]
     first = diagnose(model, measured, **noise)
@@ -523,8 +531,7 @@ def main(argv=None) -> int:
     unknown = sorted(set(chosen) - set(CLASSES))
     if unknown:
         ap.error(f"--classes: unknown {', '.join(unknown)} (known: {', '.join(CLASSES)})")
-    seeds = [(args.seed + 10 * i + j if j < 10 else args.seed + 1000 + 10 * i + j - 10, g)
-             for i in range(args.cases) for j, g in enumerate(CLASSES) if g in chosen]
+    seeds = case_seeds(args.seed, args.cases, chosen)
     for n, (seed, group) in enumerate(seeds, start=1):
         start = time.perf_counter()
         case = make_case(seed, group)

@@ -188,3 +188,9 @@ def test_following_the_finishes_changes_no_fit_and_records_what_they_reached():
     r = rules[(1, 10.0)]    # 500, 2000 and 20000 cut; 500 and 2000 end as contenders
     assert (r["finishes_cut"], r["jacobians_saved"], r["cut_contenders"]) == (3, 8 + 11 + 1,
                                                                               2)
+    # against the best end (9): after 2 Jacobians only 2000 is above 100 x 9 and goes on
+    ends = {(r["after_jacobians"], r["F"]): r for r in relevance._rules(rows, 100.0,
+                                                                         "best_end")}
+    r = ends[(2, 100.0)]
+    assert (r["finishes_cut"], r["jacobians_saved"], r["cut_contenders"]) == (1, 10, 1)
+    assert ends[(1, 1000.0)]["finishes_cut"] == 1      # 20000 > 9000, ending after 2
