@@ -52,11 +52,15 @@ def elsewhere(diagnosis) -> list:
 
 
 def verdict_title(diagnosis) -> str:
-    """``crack missing``, else the verdict in the words the text prints."""
-    from .text import verdict_words
+    """``crack missing`` (with what the text says remains after it, ``crack missing; a
+    difference remains after it: χ²/n 8.2, ...``), else the verdict in the words the text
+    prints."""
+    from .text import remaining_words, verdict_words
 
     if diagnosis.verdict == "effect_found":
-        return " + ".join(diagnosis.suggested) + " missing"
+        remaining = getattr(diagnosis, "remaining", None)
+        return " + ".join(diagnosis.suggested) + " missing" + (
+            "" if remaining is None else "; " + remaining_words(remaining))
     return verdict_words(diagnosis)
 
 

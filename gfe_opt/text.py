@@ -43,6 +43,13 @@ def withheld_words(withheld: dict) -> str:
             "present effects explain")
 
 
+def remaining_words(remaining: dict) -> str:
+    """``a difference remains after it: χ²/n 8.2, frequency error 0.120 %`` (a
+    diagnosis's ``remaining``; the text and the candidates figure's verdict)."""
+    return (f"a difference remains after it: χ²/n {_ratio(remaining['chi2_per_residual'])}"
+            f", frequency error {remaining['freq_error_rms_pct']:.3f} %")
+
+
 def misfit_line(m, label: str = "") -> str:
     """``frequency error 5.591 % rms, mean MAC 0.9919, χ²/n 663.6``."""
     head = f"{label}: " if label else ""
@@ -178,9 +185,7 @@ def format_diagnosis(result, model) -> str:
         if remaining is not None:
             where = (" where: " + ", ".join(_place(x) for x in remaining["where"])
                      if remaining["where"] else "")
-            lines.append(f"  a difference remains after it: χ²/n "
-                         f"{_ratio(remaining['chi2_per_residual'])}, frequency error "
-                         f"{remaining['freq_error_rms_pct']:.3f} %{where} — diagnose again "
+            lines.append(f"  {remaining_words(remaining)}{where} — diagnose again "
                          "after adding it")
         adds = " ".join(f"--add {a}" for a in result.add_arguments())
         them = "it" if len(result.suggested) == 1 else "them"

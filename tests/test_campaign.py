@@ -16,6 +16,8 @@ import pytest
 
 from gfe_opt.diagnosis import diagnose
 from gfe_opt.measured import make_measured
+from gfe_opt.report import diagnosis_figures
+from gfe_opt.text import format_diagnosis, remaining_words
 
 from .conftest import make_model
 from .reference import ReferenceBeam, interior
@@ -31,7 +33,8 @@ def test_another_crack_law_is_found_and_what_remains_is_said():
     k = 1.0 / line_spring_compliance(0.45, EI, 0.03175)
     s = interior(L, 30)
     f, y = ReferenceBeam(elements=800, hinges=[(x0, k)]).measure(6, s, seed=4)
-    d = diagnose(make_model(), make_measured(s, "w", f, y, "hinge"),
+    model = make_model()
+    d = diagnose(model, make_measured(s, "w", f, y, "hinge"),
                  shape_noise=0.003, freq_noise=0.0005)
     assert d.verdict == "effect_found"
     assert d.suggested and d.suggested[0] in ("crack", "section_loss")
@@ -42,6 +45,15 @@ def test_another_crack_law_is_found_and_what_remains_is_said():
         assert out["remaining"]["chi2_per_residual"] > 1.0
         assert set(out["remaining"]) == {"chi2_per_residual", "freq_error_rms_pct", "where"}
         assert all(0.0 <= w <= L for w in out["remaining"]["where"])
+    # the candidates figure's verdict says what the text says remains (it said "crack
+    # missing" alone, as if the crack explained it all)
+    title = " ".join(diagnosis_figures(d, model)["candidates.png"].get_suptitle().split())
+    words = " ".join(format_diagnosis(d, model).split())
+    if out["remaining"] is not None:
+        said = remaining_words(d.remaining)
+        assert said in words and title == f"verdict: {d.suggested[0]} missing; {said}"
+    else:
+        assert "difference remains" not in title + words
 
 
 def test_what_another_crack_law_leaves_is_not_named_as_a_further_effect():
