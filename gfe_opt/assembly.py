@@ -419,12 +419,15 @@ def _support_range(support, L: float, n: int) -> tuple[int, int]:
     return max(int(np.floor(support[0] / L)), 0), min(int(np.ceil(support[1] / L)), n)
 
 
-def stiffness_elements(kind: str, params: dict, L: float) -> np.ndarray:
-    """Generic element stiffness (eq. 2, eq. 11) in physical DOFs, (n_elements, n, n)."""
+def stiffness_elements(kind: str, params: dict, L) -> np.ndarray:
+    """Generic element stiffness (eq. 2, eq. 11) in physical DOFs, (n_elements, n, n); ``L``
+    the elements' length, or one length an element (a frame's members)."""
     if kind == "bar":
         return el.generic_bar_stiffness(params["k"], L)
     t = el.beam_dof_scaling(L)
     ks = el.generic_beam_stiffness(params["k_ww"], params["k_wt"], params["k_tt"])
+    if np.ndim(L):
+        return ks * (t[:, :, None] * t[:, None, :]) / np.asarray(L)[:, None, None] ** 3
     return ks * (t[:, None] * t[None, :]) / L**3
 
 

@@ -704,33 +704,6 @@ def _build_mesh(model: FrameModel) -> FrameMesh:
                      constrained=np.array(sorted(fixed), dtype=int))
 
 
-def _zones(model: FrameModel, member_id: str) -> list[tuple[float, float, float, float]]:
-    """(start, end, stiffness_ratio, mass_ratio) of each ``section_loss`` zone on a member
-    (m from its start node)."""
-    return [(e["position"] - e["length"] / 2.0, e["position"] + e["length"] / 2.0,
-             e["stiffness_ratio"], e["mass_ratio"]) for e in model.raw_effects
-            if e["effect"] == "section_loss" and e["member"] == member_id]
-
-
-def _zone_factor(zones, which: int):
-    """The product of the zones' ratios (``which``: 2 stiffness, 3 mass) at x, 1 outside."""
-    def q(x):
-        out = np.ones_like(np.asarray(x, dtype=float))
-        for zone in zones:
-            out = out * np.where((x >= zone[0]) & (x <= zone[1]), zone[which], 1.0)
-        return out
-
-    return q
-
-
-def _zoned_elements(zones, step: float, count: int) -> list[int]:
-    """The elements of a member (each ``step`` long) that a zone covers, even in part."""
-    out = set()
-    for a, b, *_ in zones:
-        out.update(range(max(int(a // step), 0), min(int(math.ceil(b / step)), count)))
-    return sorted(out)
-
-
 #: the effects that change a member's elements (the others act at joints, supports and
 #: places: springs, masses, applied in :func:`frame_matrices`)
 _ELEMENT_EFFECTS = ("crack", "section_loss", "axial_stiffness", "axial_load", "foundation",
@@ -790,141 +763,55 @@ def member_elements(model: FrameModel) -> list[MemberElements]:
     return out
 
 
-def _member_bending(model: FrameModel, member: Member, L: float) -> np.ndarray:
-    """(n, 3): k_ww, k_wθ, k_θθ of each element of ``member`` (each ``L`` long) [N m²]
-    (eq. 11): Euler–Bernoulli, or the exact static element of EI(x) where a crack's
-    disturbance or a section loss's zone (EI × its stiffness ratio) reaches, and on every
-    element of a member with a ``stiffness_profile`` (EI × its piecewise-linear ratio)."""
-    ei0 = model.stiffness_factor * member.E * member.inertia
-    EI = np.full(member.elements, ei0)
-    out = np.stack([12.0 * EI, 6.0 * EI, 4.0 * EI], axis=1)
-    cracks = [(e["position"], e["depth_ratio"]) for e in model.raw_effects
-              if e["effect"] == "crack" and e["member"] == member.id]
-    zones = _zones(model, member.id)
-    profile = next(((np.asarray(e["x"], float), np.asarray(e["ratio"], float))
-                    for e in model.raw_effects
-                    if e["effect"] == "stiffness_profile" and e["member"] == member.id), None)
-    if not cracks and not zones and profile is None:
-        return out
-    from .effects.crack import CRACK_REACH
+def member_lines(model: FrameModel, member: Member):
+    """``member`` as a beam (its bending) and as a bar (its axial motion), each a
+    :class:`~gfe_opt.model.Model` along the member (positions from its start node) carrying
+    the member's element effects as that line's own effects: what each changes comes from
+    the effect's ``contribute``, as on a beam or a bar (issue 24: one code path).  A crack,
+    a stiffness profile, an axial load and a foundation act on the bending; a mass profile
+    on both; a section loss on both, scaling the bar's EA by its mass ratio (the zone's
+    area changes as its mass, the material stays); an ``axial_stiffness`` scales the bar's
+    EA by its ratio (a loose brace); the member's κGA (a ``member_shear``, or a ``shear``)
+    is the beam's ``shear``."""
+    from .model import Effect, Model
 
-    half = None if member.depth is None else member.depth / 2.0
-    decay = None if not cracks else half / (2.0 * el.SHEN_PIERRE_GAMMA)
-    zoned = _zone_factor(zones, 2)
-
-    def rigidity(x):
-        q = zoned(x)
-        if profile is not None:
-            q = q * np.interp(x, *profile)
-        for x_c, ratio in cracks:
-            q = q * el.christides_barr_q(x, x_c, ratio, half)
-        return ei0 * q
-
-    reached = set(_zoned_elements(zones, L, member.elements))
-    if profile is not None:
-        reached = set(range(member.elements))
-    for x_c, _ in cracks:
-        lo = max(int((x_c - CRACK_REACH * decay) // L), 0)
-        hi = min(int((x_c + CRACK_REACH * decay) // L) + 1, member.elements)
-        reached.update(range(lo, hi))
-    plain = []
-    for j in sorted(reached):
-        x0 = j * L
-        inside = (*(x_c for x_c, _ in cracks if x0 < x_c < x0 + L), *_edges(zones, x0, L),
-                  *(() if profile is None else (k for k in profile[0] if x0 < k < x0 + L)))
-        if not inside:
-            plain.append(j)
+    E = model.stiffness_factor * member.E
+    bending, axial, ratio = [], [], 1.0
+    for e in model.effects:
+        if e.name not in _ELEMENT_EFFECTS or e.parameters.get("member") != member.id:
             continue
-        out[j] = el.beam_stiffness_from_flexibility(rigidity, x0, L, breakpoints=inside,
-                                                    refine_scale=decay)
-    if plain:   # the elements with no kink inside, together: the same points and sums
-        j = np.array(plain)
-        x, w = el.element_quadratures(j * L, j * L + L)
-        out[j] = np.stack(el.flexibility_parameters(x - (j * L)[:, None], w / rigidity(x), L),
-                          axis=1)
-    return out
-
-
-def _member_axial(model: FrameModel, member: Member, L: float) -> np.ndarray:
-    """(n,): EA of each element of ``member`` [N], times the ``ratio`` of an
-    ``axial_stiffness`` effect on it (a loose brace); where a section loss's zone covers an
-    element, that of the element's exact axial flexibility ∫ dx / EA(x) (EA × the zone's
-    mass ratio: the zone's area changes as its mass, the material stays)."""
-    ratio = next((e["ratio"] for e in model.raw_effects
-                  if e["effect"] == "axial_stiffness" and e["member"] == member.id), 1.0)
-    out = np.full(member.elements, model.stiffness_factor * member.E * member.area * ratio)
-    zones = _zones(model, member.id)
-    for j, _, x, w in _zoned_quadrature(zones, L, member.elements):
-        out[j] *= L / np.sum(w / _zone_factor(zones, 3)(x), axis=-1)
-    return out
-
-
-def _zoned_quadrature(zones, L: float, count: int):
-    """The elements of a member (``count`` elements ``L`` long) that a section-loss zone
-    covers, even in part: (their indices, their starts x0 along the member, quadrature
-    points x and weights w exact for the zones' piecewise-constant ratios, a row an
-    element): each element with a zone's edge inside alone, the others together (the same
-    numbers as one at a time)."""
-    whole = []
-    for j in _zoned_elements(zones, L, count):
-        edges = _edges(zones, j * L, L)
-        if not edges:
-            whole.append(j)
-            continue
-        x, w = el.element_quadrature(j * L, (j + 1) * L, edges)
-        yield np.array([j]), np.array([j * L]), x[None, :], w[None, :]
-    if whole:
-        j = np.array(whole)
-        x, w = el.element_quadratures(j * L, (j + 1) * L)
-        yield j, j * L, x, w
-
-
-def _edges(zones, x0: float, L: float) -> tuple:
-    """The zones' edges strictly inside [x0, x0 + L]."""
-    return tuple(edge for z in zones for edge in z[:2] if x0 < edge < x0 + L)
-
-
-def _zone_mass(zones, rhoA, x0, L: float, x, w) -> np.ndarray:
-    """(..., 6, 6) local mass a member's section-loss zones add to the elements
-    [x0, x0 + L] (``rhoA`` and ``x0`` one value an element, ``x``, ``w`` a row): ρA (mass
-    ratio − 1) ∫ NᵀN over the part covered (bar and beam shape functions, exact
-    quadrature)."""
-    return _added_mass(np.asarray(rhoA)[..., None] * w * (_zone_factor(zones, 3)(x) - 1.0),
-                       x0, L, x)
+        p = {k: v for k, v in e.parameters.items() if k != "member"}
+        if e.name == "axial_stiffness":
+            ratio *= float(p["ratio"])
+        elif e.name != "member_shear":   # (its κGA below)
+            bending.append(Effect(e.name, p))
+            if e.name == "section_loss":
+                axial.append(Effect(e.name, {**p, "stiffness_ratio": p["mass_ratio"]}))
+            elif e.name == "mass_profile":
+                axial.append(Effect(e.name, p))
+    kGA = member_shear_rigidity(model, member)
+    if kGA is not None:
+        bending.append(Effect("shear", {"shear_rigidity": kGA}))
+    line = dict(name=member.id, length=model.member_length(member), elements=member.elements,
+                rho=member.rho, nu=member.nu, area=member.area, inertia=member.inertia,
+                depth=member.depth, supports=("free", "free"))
+    return (Model(kind="beam", E=E, effects=tuple(bending), **line),
+            Model(kind="bar", E=E * ratio, effects=tuple(axial), **line))
 
 
 #: the axial (u) and bending (w, θ) rows and columns of a frame element's six local DOFs, as
-#: index arrays (``A[_AXIAL]`` is the 2 x 2 block, ``A[_EACH_AXIAL]`` each element's)
-_AXIAL = np.ix_([0, 3], [0, 3])
-_BENDING = np.ix_([1, 2, 4, 5], [1, 2, 4, 5])
-_EACH_AXIAL = (slice(None), *_AXIAL)
-_EACH_BENDING = (slice(None), *_BENDING)
-
-
-def _added_mass(c, x0: float, L: float, x) -> np.ndarray:
-    """(..., 6, 6) local mass Σ c NᵀN of the elements [x0, x0 + L] at points ``x`` with
-    weights ``c`` (the added ρA times the quadrature weight; bar and beam shape functions;
-    the points on the last axis, ``x0`` one value a row)."""
-    s = (x - np.asarray(x0)[..., None]) / L
-    added = np.zeros(x.shape[:-1] + (6, 6))
-    bar, beam = el.linear(s), el.hermite(s) * el.beam_dof_scaling(np.array([L]))[0]
-    added[(..., *_AXIAL)] = np.swapaxes(bar, -1, -2) @ (c[..., None] * bar)
-    added[(..., *_BENDING)] = np.swapaxes(beam, -1, -2) @ (c[..., None] * beam)
-    return added
+#: index arrays (``A[_EACH_AXIAL]`` is each element's 2 x 2 axial block)
+_EACH_AXIAL = (slice(None), *np.ix_([0, 3], [0, 3]))
+_EACH_BENDING = (slice(None), *np.ix_([1, 2, 4, 5], [1, 2, 4, 5]))
 
 
 @dataclass(frozen=True)
 class _MemberStatic:
     """What a member's elements share whatever the effects that move in a fit (cracks,
-    zones, profiles, tension, foundation, the material's stiffness): element lengths, ρA,
-    the DOF scaling and its outer product, the local mass of bar ⊕ beam (Timoshenko's when
-    the member is), the rotation T and Tᵀ, and M in global axes (a member no zone or mass
-    profile changes)."""
+    zones, profiles, tension, foundation, the material's stiffness): the rotation T and Tᵀ,
+    and M in global axes of the member's lines with no effect on their mass (bar ⊕ beam,
+    Timoshenko's when the member is)."""
 
-    L: np.ndarray
-    rhoA: np.ndarray
-    scaling2: np.ndarray
-    local_m: np.ndarray
     T: np.ndarray
     Tt: np.ndarray
     M: np.ndarray
@@ -933,40 +820,21 @@ class _MemberStatic:
 _MEMBER_STATIC: dict = {}
 
 
-def _member_static(model: FrameModel, member: Member, kGA) -> _MemberStatic:
-    """``member``'s :class:`_MemberStatic` (κGA ``kGA``, None: Euler–Bernoulli), kept by
-    what decides it (read-only arrays)."""
+def _member_static(model: FrameModel, member: Member, bending, axial) -> _MemberStatic:
+    """``member``'s :class:`_MemberStatic` (``bending``, ``axial``: its
+    :func:`member_lines`' builders), kept by what decides it (read-only arrays)."""
     (x0, y0), (x1, y1) = model.nodes[member.start], model.nodes[member.end]
-    key = (member, x0, y0, x1, y1, kGA,
-           None if kGA is None else model.stiffness_factor)
+    kGA = bending.shear_rigidity
+    key = (member, x0, y0, x1, y1, kGA, None if kGA is None else model.stiffness_factor)
     kept = _MEMBER_STATIC.get(key)
     if kept is not None:
         return kept
-    n = member.elements
     length = math.hypot(x1 - x0, y1 - y0)
-    L = np.full(n, length / member.elements)
-    rhoA = np.full(n, member.rho * member.area)
-    local_m = np.zeros((n, 6, 6))
-    local_m[_EACH_AXIAL] = el.generic_bar_mass(
-        rhoA, L, np.full(n, el.BAR_MASS_BETA["consistent"]))
-    scaling = el.beam_dof_scaling(L)                     # (n, 4)
-    if kGA is None:
-        mass_params = el.CONSISTENT_BEAM_MASS
-    else:   # eq. 18's translational mass and the rotary inertia ρI, g of the member's EI
-        ei = model.stiffness_factor * member.E * member.inertia
-        _, mass_params = el.timoshenko_parameters(ei, kGA, L[0])
-    mass = (rhoA * L)[:, None, None] * el.symmetric_beam_mass(
-        **{key: np.full(n, v) for key, v in mass_params.items()})
-    if kGA is not None:
-        mass = mass + el.timoshenko_rotary_inertia(
-            np.full(n, member.rho * member.inertia), L,
-            el.shear_parameter(np.full(n, ei), kGA, L))
-    local_m[_EACH_BENDING] = mass * scaling[:, :, None] * scaling[:, None, :]
-    T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (n, 1)))
+    local_m = _local(_line_mass(axial, plain=True), _line_mass(bending, plain=True))
+    T = rotations(np.tile([(x1 - x0) / length, (y1 - y0) / length], (member.elements, 1)))
     Tt = np.swapaxes(T, 1, 2)
-    kept = _MemberStatic(L, rhoA, scaling[:, :, None] * scaling[:, None, :], local_m, T, Tt,
-                         Tt @ local_m @ T)
-    for array in (kept.L, kept.rhoA, kept.scaling2, kept.local_m, kept.T, kept.Tt, kept.M):
+    kept = _MemberStatic(T, Tt, Tt @ local_m @ T)
+    for array in (kept.T, kept.Tt, kept.M):
         array.flags.writeable = False
     if len(_MEMBER_STATIC) >= _MEMBER_ELEMENTS_KEPT:
         _MEMBER_STATIC.clear()
@@ -974,59 +842,44 @@ def _member_static(model: FrameModel, member: Member, kGA) -> _MemberStatic:
     return kept
 
 
+def _line_mass(build, plain: bool = False) -> np.ndarray:
+    """The element masses of a line's builder (``plain``: without its effects' changes,
+    the numbers its elements no effect reaches have)."""
+    from .assembly import Builder
+
+    if plain:
+        build = Builder(build.model, shear_rigidity=build.shear_rigidity)
+    return build._mass(build.model.youngs_modulus)
+
+
+def _local(axial, bending) -> np.ndarray:
+    """(n, 6, 6): bar ⊕ beam in the member's six local DOFs [u, w, θ, u, w, θ]."""
+    out = np.zeros((axial.shape[0], 6, 6))
+    out[_EACH_AXIAL] = axial
+    out[_EACH_BENDING] = bending
+    return out
+
+
 def _member_elements(model: FrameModel, k: int) -> MemberElements:
-    """One member's elements: bar ⊕ beam in the member's axes, rotated into global axes by
-    T = diag(R, R) (what does not change with the effects from :func:`_member_static`)."""
+    """One member's elements: its :func:`member_lines` (the beam's and the bar's elements
+    as :mod:`gfe_opt.assembly` builds them for a beam and a bar), bar ⊕ beam in the
+    member's axes, rotated into global axes by T = diag(R, R)."""
+    from .assembly import builder, stiffness_elements
+
     member = model.members[k]
-    n = member.elements
-    kGA = member_shear_rigidity(model, member)
-    static = _member_static(model, member, kGA)
-    L, rhoA = static.L, static.rhoA
-    EA = _member_axial(model, member, L[0])
-    local_k = np.zeros((n, 6, 6))
-    local_k[_EACH_AXIAL] = el.generic_bar_stiffness(EA, L)
-    p = _member_bending(model, member, L[0])
-    g = None
-    if kGA is not None:   # eq. 18's shear softening of each element, its own EI (a crack's)
-        g = el.shear_parameter(p[:, 0] / 12.0, kGA, L)
-        soft = el.timoshenko_correction({"k_ww": p[:, 0], "k_wt": p[:, 1], "k_tt": p[:, 2]}, g)
-        p = np.stack([soft["k_ww"], soft["k_wt"], soft["k_tt"]], axis=1)
-    local_k[_EACH_BENDING] = bending_stiffness(p, L)
-    tension = _member_tension(model, member)
-    if tension:   # geometric stiffness T ∫ N'ᵀN' dx of the transverse motion
-        local_k[_EACH_BENDING] += tension * slope_gram(L[0]) * static.scaling2
-    foundation = _member_value(model, member, "foundation", "stiffness")
-    if foundation:   # k_f ∫ NᵀN dx of the transverse motion (the beam's foundation)
-        local_k[_EACH_BENDING] += foundation * L[0] * el.HERMITE_GRAM * static.scaling2
-    local_m = None
-    zones = _zones(model, member.id)
-    for j, start, x, w in _zoned_quadrature(zones, L[0], n):
-        local_m = static.local_m.copy() if local_m is None else local_m
-        local_m[j] += _zone_mass(zones, rhoA[j], start, L[0], x, w)
-    profile = next(((np.asarray(e["x"], float), np.asarray(e["ratio"], float))
-                    for e in model.raw_effects
-                    if e["effect"] == "mass_profile" and e["member"] == member.id), None)
-    if profile is not None:   # ρA × its piecewise-linear ratio on every element
-        local_m = static.local_m.copy() if local_m is None else local_m
-        for j in range(n):
-            start = j * L[0]
-            x, w = el.element_quadrature(start, start + L[0], tuple(
-                k for k in profile[0] if start < k < start + L[0]))
-            local_m[j] += _added_mass(rhoA[j] * w * (np.interp(x, *profile) - 1.0), start,
-                                      L[0], x)
-    M = static.M if local_m is None else static.Tt @ local_m @ static.T
-    return MemberElements(p, EA, static.Tt @ local_k @ static.T, M, tension, foundation, g)
-
-
-def bending_stiffness(p, L) -> np.ndarray:
-    """(n, 4, 4) eq. 11's generic beam stiffness H^T P H / L³ in the physical DOFs
-    [w, θ, w, θ] of n elements of lengths ``L``, ``p`` (n, 3) their k_ww, k_wθ, k_θθ."""
-    p = np.asarray(p, float)
-    P = np.stack([np.stack([p[:, 0], p[:, 1]], -1), np.stack([p[:, 1], p[:, 2]], -1)], -2)
-    H = el.BEAM_DEFORMATION_H
-    scaling = el.beam_dof_scaling(L)                     # (n, 4)
-    scaled = np.einsum("ji,ejk,kl->eil", H, P, H) / L[:, None, None] ** 3
-    return scaled * scaling[:, :, None] * scaling[:, None, :]
+    beam, bar = member_lines(model, member)
+    bending, axial = builder(beam), builder(bar)
+    static = _member_static(model, member, bending, axial)
+    L = beam.element_length
+    p, g = bending._stiffness(beam.youngs_modulus * beam.inertia)
+    EA = axial._stiffness(bar.youngs_modulus * bar.area)[0]["k"]
+    local_k = _local(stiffness_elements("bar", {"k": EA}, L),
+                     stiffness_elements("beam", p, L) + bending._extra())
+    M = static.M if not (bending.mass or axial.mass) else \
+        static.Tt @ _local(_line_mass(axial), _line_mass(bending)) @ static.T
+    return MemberElements(np.stack([p["k_ww"], p["k_wt"], p["k_tt"]], axis=1), EA,
+                          static.Tt @ local_k @ static.T, M, _member_tension(model, member),
+                          _member_value(model, member, "foundation", "stiffness"), g)
 
 
 def shear_rigidity(model: FrameModel) -> float | None:

@@ -32,11 +32,11 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import lsqr, splu
 
 from . import elements as el
+from .assembly import stiffness_elements
 from .frame import (
     FrameDiscretisation,
     FrameModel,
     _assemble,
-    bending_stiffness,
     frame_matrices,
     frame_mesh,
     member_elements,
@@ -81,11 +81,11 @@ class FrameGeneric:
         L, n = self.element_length, self.n_elements
         T = rotations(self.mesh.cosines)
         Tt = np.swapaxes(T, 1, 2)
-        self._units = {}   # each generic parameter's unit element, from the frame's formulas
-        for i, key in enumerate(BEAM_KEYS):
+        self._units = {}   # each generic parameter's unit element, as the members' elements
+        for key in BEAM_KEYS:
             local = np.zeros((n, 6, 6))
-            local[np.ix_(range(n), _BEND, _BEND)] = bending_stiffness(
-                np.repeat(np.eye(3)[i][None], n, axis=0), L)
+            local[np.ix_(range(n), _BEND, _BEND)] = stiffness_elements(
+                "beam", {k: np.full(n, float(k == key)) for k in BEAM_KEYS}, L)
             self._units[key] = Tt @ local @ T
         local = np.zeros((n, 6, 6))
         local[np.ix_(range(n), _AXIAL, _AXIAL)] = el.generic_bar_stiffness(np.ones(n), L)
