@@ -337,10 +337,11 @@ def test_a_step_that_refutes_the_secant_term_does_not_leave_the_fit_creeping():
     """A point spring started on a member of the three-storey frame away from the change:
     its first step takes the stiffness to its lower bound, and the secant term S built on
     that step (the place's curvature at 10⁵ times the stiffness) no longer holds where χ²
-    along the place curves down (yᵀs ≤ 0).  Kept, it made the place creep at a few 1e-4 of
-    the member a step while the gradient grew: on these 18 starts 410 Jacobians, one fit
-    out of its 100 steps (102) and four more ``not_converged``, against 217 with S dropped
-    there, every end as low to 0.012 noise floors.  The data: the exact frame (dynamic
+    along the place curves down (yᵀs ≤ 0) with the stiffness left on its bound.  Kept, it
+    made the place creep at a few 1e-4 of the member a step while the gradient grew: on
+    these 18 starts 410 Jacobians, one fit out of its 100 steps (102) and four more
+    ``not_converged``, against 217 with S dropped there, every end as low to 0.012 noise
+    floors.  The data: the exact frame (dynamic
     stiffness, tests/frame_reference.py) with a mass at floor-2's left joint."""
     from dataclasses import replace
 
