@@ -1,0 +1,112 @@
+"""How much rounding the model's mode shapes carry, and what it does to χ² near an optimum.
+
+The eigenvalues gfe-opt reports are Rayleigh quotients of the shapes (gfe_opt.modal), so a
+shape error enters them squared; the shapes themselves carry the eigensolver's rounding,
+about eps·λ_max/gap of a dense generalised solve (λ_max the mesh's highest eigenvalue).  The
+study moves a crack by h of the beam's length (h = 1e-11 .. 1e-7) and prints the second
+difference of each mode's shape (max over DOFs, relative to the mode's largest value): a
+smooth function gives h²·φ'', rounding gives a floor that does not fall with h.  It does so
+for the shapes as gfe-opt computes them and, for comparison (not the package's code), after
+one step of inverse iteration at each mode's own eigenvalue.  Then the same for χ²: the
+monitoring campaign of tests/test_batch.py (20 elements, 9 sensors, 4 modes), its set 8 at
+the fit's end (a/d 0.356), χ² at the crack moved by ±h and ±2h, minus χ² there, in noise
+floors.
+
+    python scripts/study_shape_rounding.py
+    OPENBLAS_CORETYPE=Sandybridge python scripts/study_shape_rounding.py
+"""
+
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as sla
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import gfe_opt.modal as modal  # noqa: E402
+from gfe_opt.fitting import misfit, noise_of  # noqa: E402
+from gfe_opt.measured import load_measured  # noqa: E402
+from gfe_opt.modal import model_modes  # noqa: E402
+from gfe_opt.model import Effect, model_from_dict  # noqa: E402
+from tests.conftest import STEEL_BEAM  # noqa: E402
+from tests.truths import write_campaign  # noqa: E402
+
+#: where tests/test_batch.py's set 8 fit ends (material E factor, crack position / length,
+#: depth ratio), as `gfe-opt batch` printed it on this machine
+END = (1.00916456, 0.33104147, 0.35599971)
+STEPS = (1e-11, 1e-9, 1e-7)
+
+
+def _refined_eigh(A, B, subset_by_index=None, **options):
+    """scipy's eigh, then one inverse-iteration step per mode at its own eigenvalue."""
+    lam, vec = _EIGH(A, B, subset_by_index=subset_by_index, **options)
+    out = np.empty_like(vec)
+    for i in range(vec.shape[1]):
+        x = np.linalg.solve(A - lam[i] * B, B @ vec[:, i])
+        x /= np.sqrt(x @ B @ x)
+        out[:, i] = x * np.sign(x @ B @ vec[:, i])
+    return lam, out
+
+
+_EIGH = sla.eigh
+
+
+def _model(base, position, E=END[0], depth=END[2]):
+    return base.with_effects([Effect("material", {"E": E * base.E}),
+                              Effect("crack", {"position": position, "depth_ratio": depth})])
+
+
+def _shape_floor(base, refined: bool) -> dict:
+    modal.sla.eigh = _refined_eigh if refined else _EIGH
+    try:
+        out = {}
+        x0 = END[1] * base.length
+        for h in STEPS:
+            S = [model_modes(_model(base, x0 + k * h * base.length), 4).shapes
+                 for k in (-1, 0, 1)]
+            d2 = (S[2] - 2 * S[1] + S[0]) / np.abs(S[1]).max(axis=0)
+            out[f"{h:.0e}"] = [float(f"{v:.2e}") for v in np.abs(d2).max(axis=0)]
+        return out
+    finally:
+        modal.sla.eigh = _EIGH
+
+
+def _chi2_floor(base, refined: bool, measured) -> dict:
+    modal.sla.eigh = _refined_eigh if refined else _EIGH
+    try:
+        x0 = END[1] * base.length
+        out = {}
+        for h in STEPS:
+            fits = [misfit(_model(base, x0 + k * h * base.length), measured, noise_of())
+                    for k in (-2, -1, 0, 1, 2)]
+            floor = max(1.0, fits[2].chi2 / (fits[2].n_residuals - 3))
+            out[f"{h:.0e}"] = [float(f"{(f.chi2 - fits[2].chi2) / floor:.2e}") for f in fits]
+        return out
+    finally:
+        modal.sla.eigh = _EIGH
+
+
+def main():
+    small = {**STEEL_BEAM, "elements": 20}
+    base = model_from_dict(small, "small")
+    with tempfile.TemporaryDirectory() as tmp:
+        write_campaign(base, Path(tmp) / "sets", 10, n_modes=4, reference_elements=200,
+                       sensors=np.linspace(0.05, 0.525, 9), onset=0.3)
+        measured = load_measured(Path(tmp) / "sets" / "set-0008.json")
+        result = {
+            "shape_second_difference": {
+                "as_computed": _shape_floor(base, False),
+                "one_inverse_iteration": _shape_floor(base, True)},
+            "chi2_minus_centre_floors_at_-2h..2h": {
+                "as_computed": _chi2_floor(base, False, measured),
+                "one_inverse_iteration": _chi2_floor(base, True, measured)},
+            "stopping_rule_floors": 1e-9,
+        }
+    print(json.dumps(result, indent=1))
+
+
+if __name__ == "__main__":
+    main()
