@@ -55,7 +55,8 @@ def test_study_shape_rounding_shows_the_floor_and_what_lowers_it(tmp_path):
     """The model's shapes carry a rounding floor that a smaller step does not lower (their
     second difference at h = 1e-11 is not h² smaller than at 1e-7: rounding, not
     curvature), and one inverse-iteration step lowers it at least tenfold; χ² near set 8's
-    optimum is rough above the finish's 1e-9 floors as computed and below it refined."""
+    optimum is rough above the finish's 1e-9 floors as computed and below it refined; the
+    frames' shapes from shift-invert Lanczos sit far below the dense solve's floor."""
     out = json.loads(_run("study_shape_rounding.py", cwd=tmp_path))
     shapes = out["shape_second_difference"]
     raw, refined = shapes["as_computed"], shapes["one_inverse_iteration"]
@@ -65,6 +66,8 @@ def test_study_shape_rounding_shows_the_floor_and_what_lowers_it(tmp_path):
     rule = out["stopping_rule_floors"]
     assert max(abs(v) for v in chi2["as_computed"]["1e-11"]) > 3 * rule
     assert max(abs(v) for v in chi2["one_inverse_iteration"]["1e-11"]) < rule
+    frames = out["frame_shape_second_difference"]   # Lanczos's shapes carry no such floor
+    assert max(frames["three_storey_sparse"]["1e-11"]) < 0.1 * max(frames["portal_dense"]["1e-11"])
 
 
 def test_shipped_examples_are_what_the_script_writes(tmp_path):
