@@ -1040,8 +1040,8 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     for _ in range(steps):
         Ju = J / d
         g = Ju.T @ r
-        held = (((z - lower) <= 1e-12 * span) & (g > 0)) | (((upper - z) <= 1e-12 * span)
-                                                            & (g < 0))
+        at_lower, at_upper = _on_bounds(z, lower, upper, span)
+        held = (at_lower & (g > 0)) | (at_upper & (g < 0))
         floor = max(1.0, value / max(r.size - n, 1))
         # a variable that cannot change χ² by the stopping rule's amount over its whole
         # range (linearised: 2|r||J_k| span + (|J_k| span)²) takes no part: its column,
@@ -1110,11 +1110,16 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
         pairing = trial_pairing
         lam = 0.0 if lam <= 1e-6 else lam / 10.0
         J_new = _jacobian(residual, trial, r_trial, lower, upper)
-        on_bound = bool(np.any(((trial - lower) <= 1e-12 * span)
-                               | ((upper - trial) <= 1e-12 * span)))
+        on_bound = bool(np.any(np.logical_or(*_on_bounds(trial, lower, upper, span))))
         S = _secant(S, (trial - z) * d, J / d, J_new / d, r_trial, g, on_bound)
         z, r, value, J = trial, r_trial, trial_value, J_new
     return z, value, decrement / floor
+
+
+def _on_bounds(z, lower, upper, span):
+    """Which variables of ``z`` sit on their lower and on their upper bound (within 1e-12
+    of their range ``span``): two boolean arrays."""
+    return (z - lower) <= 1e-12 * span, (upper - z) <= 1e-12 * span
 
 
 def _pairing(residual):
