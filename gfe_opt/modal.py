@@ -108,7 +108,8 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     try:
         if dense:
             dd = np.outer(d, d)
-            lam, vec = sla.eigh(Kf * dd, Mf * dd, subset_by_index=[0, n_modes - 1])
+            A, B = Kf * dd, Mf * dd
+            lam, vec = sla.eigh(A, B, subset_by_index=[0, n_modes - 1])
         else:
             Ks, Ms = _restricted(Kf, free, d), _restricted(Mf, free, d)
             lu = spla.splu((Ks - sigma * Ms).tocsc())
@@ -123,7 +124,7 @@ def solve_modes(K, M, n_modes: int, constrained=(), eigenvalue_scale: float | No
     lam, vec = lam[order], vec[:, order]
     lam = rigid_as_zero(lam, eigenvalue_scale, roundoff_fraction)
     if dense:
-        vec = _inverse_iteration(Kf * dd, Mf * dd, lam, vec)
+        vec = _inverse_iteration(A, B, lam, vec)
     if np.any(lam < 0):
         raise GfeSolverError(f"eigen solve returned negative eigenvalues {lam[lam < 0]}: "
                              "the stiffness is not positive semidefinite (a compression above "

@@ -77,13 +77,13 @@ def test_rows_hold_every_fitted_parameter_and_the_crack_appears(campaign):
         measured = load_measured(tmp / "sets" / r["file"])
         before = misfit(model, measured, noise_of()).chi2_per_residual
         assert r["chi2_per_residual"] < before, (r["file"], r["chi2_per_residual"], before)
-        # the fit meets its rule wherever the crack is there: converged, or settled (χ²
-        # within 0.01 floors of its optimum, fitting.FINISH_SETTLED); which of the two is
-        # the arithmetic's (set 8, a/d 0.356: its last decrement 1e-8 floors under
-        # OPENBLAS_CORETYPE=Sandybridge on one machine, below 1e-9 on another); before the
-        # onset the crack sits at its null, its position is undetermined and the fit may
-        # end anyhow: then it must not look like a crack
-        assert r["solver_status"] in ("converged", "settled") or r["crack.size_sigmas"] < 3, r
+        # the fit converges wherever the crack is there (set 8, a/d 0.356, once ended
+        # `settled` under one BLAS kernel and `converged` under another: LAPACK's shapes'
+        # rounding made χ² rough above the finish's rule, scripts/study_shape_rounding.py;
+        # gfe_opt.modal refines them); before the onset the crack sits at its null, its
+        # position is undetermined and the fit may end anyhow: then it must not look like a
+        # crack
+        assert r["solver_status"] == "converged" or r["crack.size_sigmas"] < 3, r
     t = trend(rows)
     truth_depth = np.array([d for d, _ in truths])
     first_crack = int(np.argmax(truth_depth > 0))

@@ -297,3 +297,48 @@ def test_the_sparse_solves_direct_products_are_scipys_bit_for_bit():
     # here, measured)
     assert np.allclose(sparse.frequencies_hz, dense.frequencies_hz, rtol=1e-7)
     assert np.all(np.abs(np.sum(sparse.shapes * (M @ dense.shapes), axis=0)) > 1 - 1e-9)
+
+
+def test_the_dense_solves_shapes_are_smooth_in_a_parameter_below_lapacks_rounding():
+    """The shapes of the dense solve move smoothly with the model: moving a crack by 1e-11
+    of the length changes a 20-element beam's shapes by a second difference below 1e-11 of
+    their largest value (LAPACK's own shapes carry about eps·λ_max/gap, 5e-11 here:
+    ``scripts/study_shape_rounding.py``; the inverse-iteration step takes them to 1e-13),
+    and they stay an M-orthonormal set of eigenvectors to rounding."""
+    base = make_model(elements=20)
+    h, x0 = 1e-11 * base.length, 0.331 * base.length
+    S = [model_modes(base.with_effects([Effect("crack", {"position": x0 + k * h,
+                                                         "depth_ratio": 0.356})]), 4).shapes
+         for k in (-1, 0, 1)]
+    d2 = np.abs(S[2] - 2 * S[1] + S[0]).max(axis=0) / np.abs(S[1]).max(axis=0)
+    assert np.all(d2 < 1e-11), d2
+    model = base.with_effects([Effect("crack", {"position": x0, "depth_ratio": 0.356})])
+    disc = discretise(model)
+    K, M = disc.global_matrices()
+    modes = model_modes(model, 4)
+    phi, lam = modes.shapes, modes.omega ** 2
+    assert np.allclose(phi.T @ (M @ phi), np.eye(4), atol=1e-12)
+    free = disc.free   # (the supports' reactions are no residual)
+    residual = np.linalg.norm((K @ phi - (M @ phi) * lam)[free], axis=0)
+    assert np.all(residual < 1e-10 * np.linalg.norm((K @ phi)[free], axis=0)), residual
+
+
+def test_inverse_iteration_leaves_a_repeated_pair_and_rigid_modes_as_they_came():
+    """A pair of equal eigenvalues would be mixed by the step (either vector is one of the
+    pair's): both keep LAPACK's vectors, as does a rigid mode; a lone elastic mode is
+    refined to the exact eigenvector."""
+    from scipy.linalg import eigh
+
+    from gfe_opt.modal import _inverse_iteration
+
+    rng = np.random.default_rng(3)
+    Q = np.linalg.qr(rng.standard_normal((6, 6)))[0]
+    A = Q @ np.diag([0.0, 1.0, 1.0, 2.5, 4.0, 9.0]) @ Q.T
+    B = np.eye(6)
+    lam, vec = eigh(A, B, subset_by_index=[0, 3])
+    lam[0] = 0.0
+    noisy = vec + 1e-9 * rng.standard_normal(vec.shape)
+    out = _inverse_iteration(A, B, lam, noisy)
+    assert np.array_equal(out[:, :3], noisy[:, :3])
+    exact = Q[:, 3] * np.sign(Q[:, 3] @ noisy[:, 3])
+    assert np.linalg.norm(out[:, 3] - exact) < 1e-13 < np.linalg.norm(noisy[:, 3] - exact)

@@ -52,22 +52,24 @@ def test_bench_eigen_accuracy(tmp_path):
 
 @pytest.mark.slow
 def test_study_shape_rounding_shows_the_floor_and_what_lowers_it(tmp_path):
-    """The model's shapes carry a rounding floor that a smaller step does not lower (their
+    """LAPACK's dense shapes carry a rounding floor that a smaller step does not lower (their
     second difference at h = 1e-11 is not h² smaller than at 1e-7: rounding, not
-    curvature), and one inverse-iteration step lowers it at least tenfold; χ² near set 8's
-    optimum is rough above the finish's 1e-9 floors as computed and below it refined; the
-    frames' shapes from shift-invert Lanczos sit far below the dense solve's floor."""
+    curvature), and the package's inverse-iteration step lowers it at least tenfold; χ² near
+    set 8's optimum is rough above the finish's 1e-9 floors from LAPACK's shapes alone and
+    below it as computed; the frames' shapes sit far below LAPACK's floor as computed."""
     out = json.loads(_run("study_shape_rounding.py", cwd=tmp_path))
     shapes = out["shape_second_difference"]
-    raw, refined = shapes["as_computed"], shapes["one_inverse_iteration"]
+    raw, refined = shapes["lapack_alone"], shapes["as_computed"]
     assert raw["1e-11"][0] > 1e-3 * raw["1e-07"][0] > 0   # 1e-8 of h² scaling: a floor
     assert all(a > 10 * b for a, b in zip(raw["1e-11"], refined["1e-11"]))
     chi2 = out["chi2_minus_centre_floors_at_-2h..2h"]
     rule = out["stopping_rule_floors"]
-    assert max(abs(v) for v in chi2["as_computed"]["1e-11"]) > 3 * rule
-    assert max(abs(v) for v in chi2["one_inverse_iteration"]["1e-11"]) < rule
-    frames = out["frame_shape_second_difference"]   # Lanczos's shapes carry no such floor
-    assert max(frames["three_storey_sparse"]["1e-11"]) < 0.1 * max(frames["portal_dense"]["1e-11"])
+    assert max(abs(v) for v in chi2["lapack_alone"]["1e-11"]) > 3 * rule
+    assert max(abs(v) for v in chi2["as_computed"]["1e-11"]) < rule
+    frames = out["frame_shape_second_difference"]
+    floor = max(frames["portal_lapack_alone"]["1e-11"])
+    assert max(frames["three_storey_sparse"]["1e-11"]) < 0.1 * floor   # Lanczos: none
+    assert max(frames["portal_as_computed"]["1e-11"]) < 0.1 * floor    # refined
 
 
 def test_shipped_examples_are_what_the_script_writes(tmp_path):
