@@ -51,7 +51,14 @@ the regularisation holds it at its initial value).
    the full solves do).  Before the screen the two sides were IPOPT and the Newton steps
    (README, Plane frames).
 
-``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale, fits, frames.
+9. The shapes' refinement (stop 69), ``--parts shapes``: the dense modal solve with and
+   without its inverse-iteration step (:func:`gfe_opt.modal._inverse_iteration`), side by
+   side in one process: one solve of a simply supported beam of 20, 46 and 200 elements
+   (5 modes, best of 200 alternated runs each), and the demo's serial ``diagnose`` (46
+   elements, best of 5 alternated runs), with its verdict and the crack found either way.
+
+``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale, fits, frames,
+shapes (the default: all but shapes).
 """
 
 import argparse
@@ -158,7 +165,74 @@ def main():
         _fits(out)
     if "frames" in parts:
         _frames(out)
+    if "shapes" in parts:
+        _shapes(out)
     print(json.dumps(out, indent=1))
+
+
+def _alternated(fns, repeats):
+    """Best time of each of ``fns`` over ``repeats`` rounds, the functions run in turn (so
+    that a change of the machine's speed falls on each alike), and each one's last result."""
+    best, results = [np.inf] * len(fns), [None] * len(fns)
+    for _ in range(repeats):
+        for i, fn in enumerate(fns):
+            start = time.perf_counter()
+            results[i] = fn()
+            best[i] = min(best[i], time.perf_counter() - start)
+    return best, results
+
+
+def _shapes(out):
+    """Part 9 (module docstring)."""
+    import gfe_opt.diagnosis as diagnosis
+    import gfe_opt.modal as modal
+    from gfe_opt.assembly import discretise
+    from gfe_opt.measured import load_measured
+    from gfe_opt.model import load_model, model_from_dict
+    from gfe_opt.problems import problem_file
+
+    sys.path.insert(0, str(ROOT))
+    from tests.conftest import STEEL_BEAM
+
+    refine = modal._inverse_iteration
+
+    def side(refined, fn):
+        def run():
+            modal._inverse_iteration = refine if refined else (lambda A, B, lam, vec: vec)
+            try:
+                return fn()
+            finally:
+                modal._inverse_iteration = refine
+        return run
+
+    rows = []
+    for n in (20, 46, 200):
+        disc = discretise(model_from_dict({**STEEL_BEAM, "elements": n}, "bench"))
+        K, M = disc.global_matrices()
+
+        def solve(K=K, M=M, disc=disc):
+            return modal.solve_modes(K, M, 5, disc.constrained, disc.eigenvalue_scale,
+                                     dense=True, free=disc.free)
+        (alone, refined), (a, b) = _alternated([side(False, solve), side(True, solve)], 200)
+        rows.append({"elements": n, "lapack_alone_ms": 1e3 * alone,
+                     "refined_ms": 1e3 * refined, "ratio": refined / alone,
+                     "frequencies_rel_diff": float(np.max(np.abs(
+                         b.frequencies_hz / a.frequencies_hz - 1)))})
+    model = load_model(problem_file("ss-steel-beam.toml"))
+    demo = load_measured(problem_file("demo-measured.json"))
+    serial, diagnosis.SERIAL_FITS = diagnosis.SERIAL_FITS, True
+    try:
+        def run():
+            d = diagnosis.diagnose(model, demo, freq_noise=0.0005, shape_noise=0.003)
+            found = d.together if d.together is not None else d.best
+            return d.verdict, [(e.name, e.parameters) for e in found.effects]
+        (alone, refined), (a, b) = _alternated([side(False, run), side(True, run)], 5)
+    finally:
+        diagnosis.SERIAL_FITS = serial
+    out["shape_refinement"] = {
+        "one_solve": rows,
+        "demo_diagnose_serial": {"lapack_alone_s": alone, "refined_s": refined,
+                                 "ratio": refined / alone, "lapack_alone": a, "refined": b}}
 
 
 def _ratio(out):
