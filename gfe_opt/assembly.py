@@ -501,9 +501,19 @@ def _quadrature(model: Model, factors, only=None):
     for e in np.flatnonzero(near):
         points = [b for b, _ in kinks if x0[e] < b < x0[e] + L]
         scales = [r for b, r in kinks if r and b in points]
-        x, w = el.element_quadrature(x0[e], x0[e] + L, points,
-                                     min(scales) if scales else None)
+        x, w = _element_quadrature(float(x0[e]), float(x0[e] + L), tuple(points),
+                                   min(scales) if scales else None)
         yield np.array([e]), (x - x0[e])[None, :], w[None, :], x[None, :]
+
+
+@lru_cache(maxsize=1024)
+def _element_quadrature(x0: float, x1: float, points: tuple, scale):
+    """:func:`~gfe_opt.elements.element_quadrature` kept (read-only): an element's graded
+    points recur in a fit (its stiffness and its mass, every model of a difference, every
+    evaluation that leaves the kink where it was)."""
+    x, w = el.element_quadrature(x0, x1, points, scale)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
 
 
 def builder(model: Model) -> Builder:

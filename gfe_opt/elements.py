@@ -91,12 +91,15 @@ def affine_matrix(constant, basis: Mapping[str, np.ndarray], params: Mapping[str
     first = params[names[0]]
     if isinstance(first, (int, float, np.ndarray, np.generic)):
         values = [np.asarray(params[n], dtype=float) for n in names]
-        shape = np.broadcast_shapes(*(v.shape for v in values))
+        shape = values[0].shape
+        if any(v.shape != shape for v in values):
+            shape = np.broadcast_shapes(*(v.shape for v in values))
+            values = [np.broadcast_to(v, shape) for v in values]
         out = np.zeros(shape + basis[names[0]].shape)
         if constant is not None:
-            out = out + constant
+            out += constant
         for n, v in zip(names, values):
-            out = out + np.broadcast_to(v, shape)[..., None, None] * basis[n]
+            out += v[..., None, None] * basis[n]
         return out
     total = 0 if constant is None else constant
     for n in names:
@@ -137,10 +140,20 @@ BEAM_DEFORMATION_H = np.array([[1.0, 0.0, -1.0, 1.0], [0.0, 1.0, 0.0, -1.0]])
 
 
 def beam_dof_scaling(L):
-    """Diagonal of T with ``[w, Lθ, w, Lθ] = T [w, θ, w, θ]``; physical K = T K_scaled T."""
+    """Diagonal of T with ``[w, Lθ, w, Lθ] = T [w, θ, w, θ]``; physical K = T K_scaled T
+    (read-only for one length: kept, every element of a mesh asks for it)."""
+    if isinstance(L, (float, int, np.floating)):
+        return _scalar_dof_scaling(float(L))
     L = np.asarray(L, dtype=float)
     one = np.ones_like(L)
     return np.stack([one, L, one, L], axis=-1)
+
+
+@lru_cache(maxsize=64)
+def _scalar_dof_scaling(L: float) -> np.ndarray:
+    out = np.array([1.0, L, 1.0, L])
+    out.flags.writeable = False
+    return out
 
 
 # --------------------------------------------------------------------------------------
@@ -392,11 +405,13 @@ def christides_barr_q(x, position, depth_ratio, half_depth, gamma=SHEN_PIERRE_GA
 def hermite(xi):
     """Cubic Hermite functions (n, 4) for scaled DOFs ``[w_i, Lθ_i, w_j, Lθ_j]``, ξ in [0, 1]."""
     xi = np.asarray(xi, dtype=float)
-    return np.stack(
-        [1 - 3 * xi**2 + 2 * xi**3, xi - 2 * xi**2 + xi**3, 3 * xi**2 - 2 * xi**3,
-         -(xi**2) + xi**3],
-        axis=-1,
-    )
+    out = np.empty(xi.shape + (4,))
+    xi2, xi3 = xi**2, xi**3
+    out[..., 0] = 1 - 3 * xi2 + 2 * xi3
+    out[..., 1] = xi - 2 * xi2 + xi3
+    out[..., 2] = 3 * xi2 - 2 * xi3
+    out[..., 3] = -xi2 + xi3
+    return out
 
 
 def hermite_d2(xi):
