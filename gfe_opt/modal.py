@@ -158,11 +158,16 @@ def _inverse_iteration(A, B, lam, vec) -> np.ndarray:
         return vec
     Bv = B @ vec[:, take]
     shifts = lam[take]
-    band = n
+    band, order = n, None
     if n > 24:   # (a beam's DOFs in order: LAPACK's banded LU, O(n band²) a mode)
         nonzero = (A != 0) | (B != 0)
-        last = n - 1 - np.argmax(nonzero[:, ::-1], axis=1)
-        band = int(np.max(last - np.arange(n)))
+        band = _bandwidth(nonzero)
+        if 4 * band >= n:   # (a frame's: banded in the order of a reverse Cuthill–McKee)
+            order, band = _banding_order(np.packbits(nonzero).tobytes(), n)
+            if 4 * band < n:
+                A, B, Bv = A[np.ix_(order, order)], B[np.ix_(order, order)], Bv[order]
+            else:
+                order = None
     try:
         if 4 * band < n:
             # LAPACK's band storage with room for the LU's fill: row 2·band + i − j, column j
@@ -185,9 +190,36 @@ def _inverse_iteration(A, B, lam, vec) -> np.ndarray:
     if not np.all(np.isfinite(norm) & (norm > 0.0)):
         return vec
     x = x / np.sqrt(norm)
+    if order is not None:   # back to the pencil's own order
+        x, Bv = x[np.argsort(order)], Bv[np.argsort(order)]
     out = vec.copy()
     out[:, take] = x * np.where(np.einsum("ij,ij->j", x, Bv) >= 0.0, 1.0, -1.0)
     return out
+
+
+def _bandwidth(nonzero) -> int:
+    """The largest |i − j| of a nonzero entry of a symmetric pattern."""
+    n = nonzero.shape[0]
+    last = n - 1 - np.argmax(nonzero[:, ::-1], axis=1)
+    return int(np.max(last - np.arange(n)))
+
+
+@lru_cache(maxsize=32)
+def _banding_order(pattern: bytes, n: int):
+    """(order, band): a reverse Cuthill–McKee ordering of the n × n symmetric pattern
+    (``np.packbits`` of it) and the bandwidth in that order.  A frame's DOFs are numbered
+    node by node, members joining nodes far apart in the numbering (the portal's pencil has
+    a band of 129 in its own order, 11 in this one): the refinement's solves then cost
+    O(n band²) a mode instead of a dense LU, O(n³) (kept per pattern: every solve of a mesh
+    has the same)."""
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    nonzero = np.unpackbits(np.frombuffer(pattern, dtype=np.uint8))[:n * n].reshape(n, n)
+    order = np.asarray(reverse_cuthill_mckee(sp.csr_matrix(nonzero), symmetric_mode=True),
+                       dtype=np.intp)
+    band = _bandwidth(nonzero[np.ix_(order, order)].astype(bool))
+    order.flags.writeable = False
+    return order, band
 
 
 class _Direct(spla.LinearOperator):
