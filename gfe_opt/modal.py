@@ -142,14 +142,16 @@ def _GBSV():
     return sla.get_lapack_funcs("gbsv", (np.zeros(1),))
 
 
-def _inverse_iteration(A, B, lam, vec) -> np.ndarray:
+def _inverse_iteration(A, B, lam, vec, reorder: bool = True) -> np.ndarray:
     """One step of inverse iteration for each elastic mode of the pencil (A, B) at its own
     eigenvalue: x = (A − λB)⁻¹ B v.  LAPACK's shapes carry rounding of about eps·λ_max/gap
     (5·10⁻¹¹ of a 20-element beam's first mode, whatever the step that moved the model:
     ``scripts/study_shape_rounding.py``), and χ² near an optimum was rough at 10⁻⁷ noise
     floors, above the finish's rule; after one step 10⁻¹³, χ² smooth to 2·10⁻¹⁰ floors.  A
     rigid mode (λ = 0) and a mode whose eigenvalue lies within 10⁻⁶ (relative) of another
-    computed one (a pair the step would mix) keep LAPACK's shape."""
+    computed one (a pair the step would mix) keep LAPACK's shape.  A pencil not banded in
+    its own order is solved banded in a reverse Cuthill–McKee order (``reorder``; else one
+    dense LU a mode, as before stop 73: ``scripts/bench.py --parts shapes`` compares)."""
     n = A.shape[0]
     gaps = np.abs(lam[:, None] - lam[None, :])
     np.fill_diagonal(gaps, np.inf)
@@ -162,7 +164,7 @@ def _inverse_iteration(A, B, lam, vec) -> np.ndarray:
     if n > 24:   # (a beam's DOFs in order: LAPACK's banded LU, O(n band²) a mode)
         nonzero = (A != 0) | (B != 0)
         band = _bandwidth(nonzero)
-        if 4 * band >= n:   # (a frame's: banded in the order of a reverse Cuthill–McKee)
+        if 4 * band >= n and reorder:   # (a frame's: banded in a reverse Cuthill–McKee order)
             order, band = _banding_order(np.packbits(nonzero).tobytes(), n)
             if 4 * band < n:
                 A, B, Bv = A[np.ix_(order, order)], B[np.ix_(order, order)], Bv[order]
