@@ -379,4 +379,5 @@ def test_a_frames_pencil_is_refined_banded_in_a_reverse_cuthill_mckee_order(monk
     # backward stable: a residual of rounding, eps ‖A‖ ‖x‖ times a modest factor
     bound = 100 * np.finfo(float).eps * np.linalg.norm(A) * np.linalg.norm(banded, axis=0)
     assert np.all(residual < bound), residual / bound
-    assert np.allclose(banded.T @ B @ banded, np.eye(8), atol=1e-12)
+    # (measured 4e-13 to 8e-13 across kernels; a step solved in the wrong order is off by O(1))
+    assert np.allclose(banded.T @ B @ banded, np.eye(8), atol=1e-10)
