@@ -754,14 +754,18 @@ def shared_pool():
 
 def warm_solver() -> None:
     """Load LAPACK's eigen solver (and IPOPT, CasADi's plugin, when fits use it) once in this
-    process, by a trivial solve of each: forked workers inherit them loaded (measured: the
-    first fit in a fresh worker took 0.1 s against 0.02 s for the same fit next)."""
+    process, by a trivial solve of each, and the modules fits import on first use: forked
+    workers inherit them loaded (measured: the first fit in a fresh worker took 0.1 s
+    against 0.02 s for the same fit next)."""
     global _WARM
     if _WARM:
         return
     import scipy.linalg as sla
 
-    from . import fitting
+    # the modules a worker's fits import on first use (the eigenvector derivatives of the
+    # Jacobian; the generic update of the realisation, with CasADi): imported once here,
+    # not once in every worker (measured: 25-47 ms a worker for the two)
+    from . import fitting, sensitivity, updating  # noqa: F401
 
     if fitting.FIT_SOLVER == "ipopt":
         import casadi as ca

@@ -236,6 +236,31 @@ def test_startup_and_input_errors_load_no_solver_nor_plotting(files, argv):
             "gfe-opt")
 
 
+BLAS_THREADS_CODE = """import sys
+from gfe_opt.entry import main
+sys.argv[1:] = ['--version']
+main()
+import numpy, scipy.linalg, threadpoolctl
+print(sorted({i['num_threads'] for i in threadpoolctl.threadpool_info()
+              if i['user_api'] == 'blas'}))"""
+
+
+@pytest.mark.parametrize("told", [None, "2"])
+def test_the_command_loads_blas_with_one_thread_unless_the_user_set_a_count(told):
+    """The `gfe-opt` command sets the BLAS libraries' thread counts to one before numpy
+    loads (every fit runs under one BLAS thread; a BLAS loaded with a pool of threads made
+    the forked fit workers slower at the same work), and a count the user set stands."""
+    if told is not None and (os.cpu_count() or 1) < 2:
+        pytest.skip("OpenBLAS takes at most one thread a core")
+    env = {k: v for k, v in os.environ.items() if not k.endswith(("NUM_THREADS", "THREADS"))}
+    if told is not None:
+        env["OPENBLAS_NUM_THREADS"] = told
+    run = subprocess.run([sys.executable, "-c", BLAS_THREADS_CODE], capture_output=True,
+                         text=True, timeout=120, env=env)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip().splitlines()[-1] == f"[{told or 1}]"
+
+
 def test_an_effect_fit_loads_no_casadi_and_ends_where_ipopt_first_did(files):
     """Issue 22: `update --add crack` fits by damped Newton steps from the grid's start,
     without loading CasADi (nor cvxpy, matplotlib); the old path (IPOPT to the valley, then
