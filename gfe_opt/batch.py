@@ -89,8 +89,6 @@ class Task:
 def run_set(task: Task, name: str, data: bytes) -> dict:
     """One row: ``task`` on the measured file ``name`` with contents ``data``.  Never
     raises for a bad set (the row holds the error); runs serially in one BLAS thread."""
-    from threadpoolctl import threadpool_limits
-
     from . import diagnosis
 
     start = time.perf_counter()
@@ -99,7 +97,7 @@ def run_set(task: Task, name: str, data: bytes) -> dict:
     serial, diagnosis.SERIAL_FITS = diagnosis.SERIAL_FITS, True
     try:
         with tempfile.TemporaryDirectory(prefix=f"{TEMP_PREFIX}{os.getpid()}-") as tmp, \
-                threadpool_limits(limits=1):
+                diagnosis.one_thread_limits():
             model_path = Path(tmp) / Path(task.model_name).name
             model_path.write_text(task.model_text)
             measured_path = Path(tmp) / Path(name).name
@@ -475,8 +473,11 @@ def _execute(task, todo, scheduler, workers, progress, skipped):
     context = multiprocessing.get_context("fork")
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                initializer=_ignore_sigint)
+    from .diagnosis import one_thread_limits
+
     try:
-        futures = [pool.submit(run_set, task, name, data) for name, data in todo]
+        with one_thread_limits():   # the workers fork at the first submit and inherit it
+            futures = [pool.submit(run_set, task, name, data) for name, data in todo]
         for future in as_completed(futures):
             row = future.result()
             report(row)
