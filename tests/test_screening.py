@@ -151,3 +151,36 @@ def test_changed_rows_read_in_place_are_the_sparse_differences():
     assert other.nnz == A0.nnz + 1   # another pattern: the sparse difference is taken
     D = sp.coo_matrix(other - A0)
     assert np.array_equal(screening._changed_rows(other, A0, 0.0, {}), D.row[D.data != 0])
+
+
+@pytest.mark.parametrize("name", ["crack", "point_mass"])
+def test_a_condensed_beams_grid_is_screened_on_the_same_beam_solved_directly(monkeypatch,
+                                                                             name):
+    """A beam solved through condensed super-elements (here 600 elements) has its grid
+    screened on the same beam at :data:`~gfe_opt.modal.CONDENSE_ABOVE` elements: the screen
+    ranks every point within a quarter of its margin of the fine solve's χ² (the points it
+    keeps are solved on the fine mesh and check it), and the fit ends where every point
+    solved on the fine mesh ends it, to the last bit, in fewer fine solves."""
+    model = load_model(problem_file("ss-steel-beam.toml")).with_elements(600)
+    hidden = (Effect("crack", {"position": 0.3, "depth_ratio": 0.4}) if name == "crack"
+              else Effect("point_mass", {"position": 0.3, "mass": 0.2}))
+    # the test from a twice finer mesh: not the model being fitted
+    truth = model.with_elements(1200).with_effects([hidden])
+    measured = synthetic_measurement(truth, 4, interior_sensors(model.length, 15),
+                                     shape_noise=0.003, freq_noise=0.0005, seed=5)
+    problem = fitting.fit_problem(model, measured, [Effect(name, {})], noise=NOISE)
+    zs = _grid(problem)
+    exact = np.array([float(np.sum(problem.residual(z) ** 2)) for z in zs])
+    screened = screening.screen(problem.residual, zs)
+    assert screened is not None and len(zs) >= 15
+    assert np.max(np.abs(screened / exact - 1)) < screening.MARGIN / 4
+    monkeypatch.setattr(fitting, "SCREEN", False)
+    plain = fitting.fit_effects(model, measured, [Effect(name, {})], noise=NOISE)
+    monkeypatch.setattr(fitting, "SCREEN", True)
+    before = dict(screening.TALLY)
+    fit = fitting.fit_effects(model, measured, [Effect(name, {})], noise=NOISE)
+    assert screening.TALLY["screened"] > before["screened"]
+    assert screening.TALLY["fallback"] == before["fallback"]
+    _same(plain, fit)
+    assert fit.evaluations < plain.evaluations / 2
+    assert fit.success and abs(fit.parameters["position"] - 0.3) < 0.01
