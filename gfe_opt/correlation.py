@@ -433,8 +433,19 @@ def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_
             disc: Discretisation | None = None) -> Comparison:
     """Compare a model with measured modes: pairs, frequency errors, MAC, COMAC, residual.
 
-    ``noise`` is the relative shape noise δ used to regularise the expansion.
+    ``noise`` is the relative shape noise δ used to regularise the expansion.  A plane
+    frame (with its measured modes, :func:`~gfe_opt.frame_data.load_frame_measured`) is
+    compared by :func:`~gfe_opt.frame_data.compare_frame`, as ``gfe-opt compare`` does.
     """
+    if getattr(model, "kind", None) == "frame":
+        from .frame_data import FrameMeasured, compare_frame
+
+        if not isinstance(measured, FrameMeasured):
+            raise GfeInputError(getattr(measured, "source", None), "sensors",
+                                "a frame's measured modes name a node or a member at each "
+                                "sensor: read them with gfe_opt.frame_data."
+                                "load_frame_measured(path, model)")
+        return compare_frame(model, measured, mac_threshold)
     disc = discretise(model) if disc is None else disc
     measured, dropped = on_model(measured, model)
     check_model_size(disc, measured, model.source or model.name)

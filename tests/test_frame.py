@@ -1490,3 +1490,22 @@ def test_a_timoshenko_reading_kept_for_its_mesh_is_the_one_built_anew(monkeypatc
     plain = frame_data.build_observation(model, frame_mesh(model), sensors).toarray()
     moved = [np.max(np.abs(r - plain)) for r in kept]
     assert moved[0] > moved[1] > moved[2] > 1e3 * moved[3] > 0, moved
+
+
+def test_the_public_compare_takes_a_frame_as_the_command_does():
+    """``gfe_opt.compare`` on a plane frame is ``compare_frame`` (what ``gfe-opt compare``
+    runs on a frame): the same pairs and errors; a frame with a beam's measured modes (no
+    node or member at a sensor) is bad input, one line, not an AttributeError."""
+    import gfe_opt
+    from gfe_opt.frame_data import compare_frame, load_frame_measured
+    from gfe_opt.measured import MeasuredModes
+
+    model = portal_frame()
+    measured = load_frame_measured(problem_file("portal-frame-semirigid.json"), model)
+    result = gfe_opt.compare(model, measured)
+    assert result.to_json() == compare_frame(model, measured).to_json()
+    assert len(result.pairs) == measured.n_modes and result.freq_error_rms_pct > 0
+    beam_like = MeasuredModes(np.array([0.1, 0.2]), "w", np.array([10.0]),
+                              np.array([[1.0], [0.5]]))
+    with pytest.raises(GfeInputError, match="load_frame_measured"):
+        gfe_opt.compare(model, beam_like)
