@@ -38,6 +38,7 @@ from .modal import Modes, discretisation_modes, rigid_body_count
 from .model import Model
 from .names import DEFAULT_COMPARE_SHAPE_NOISE as DEFAULT_SHAPE_NOISE
 from .names import DEFAULT_MAC_THRESHOLD
+from .threads import one_blas_thread
 
 
 def mac(a, b) -> np.ndarray:
@@ -428,6 +429,7 @@ class Comparison(PairSummary):
         }
 
 
+@one_blas_thread
 def compare(model: Model, measured: MeasuredModes, *, mac_threshold=DEFAULT_MAC_THRESHOLD,
             noise=DEFAULT_SHAPE_NOISE, n_model_modes: int | None = None,
             disc: Discretisation | None = None) -> Comparison:

@@ -62,7 +62,6 @@ from __future__ import annotations
 
 import contextlib
 import copy
-import functools
 import multiprocessing
 import os
 import time
@@ -97,6 +96,7 @@ from .fitting import (
 from .measured import MeasuredModes
 from .model import Effect, Model, parse_effect
 from .structure import GENERIC_FAILURES, structure
+from .threads import one_blas_thread, one_thread_limits  # noqa: F401 (public here too)
 
 __all__ = ["DEFAULT_FREQ_NOISE", "DEFAULT_SHAPE_NOISE", "Diagnosis", "UpdateOutcome",
            "diagnose", "parse_effect", "update"]
@@ -798,20 +798,6 @@ def _single_threaded_blas():
     _BLAS_LIMIT = one_thread_limits()
 
 
-def one_thread_limits():
-    """One thread for each thread pool (BLAS, OpenMP) that has more, in effect from this
-    call (threadpoolctl's limits, a context manager restoring them); a null context where
-    every pool has one.  A count is never set again where it is one already: OpenBLAS
-    restarts its pool of threads when its count is set in a process forked from one that
-    had the pool (a fit worker), and the new idle threads spin beside the worker for their
-    first fraction of a second (measured: a 92-DOF generalised eigensolve in two such
-    workers at once 0.76 ms against 0.54 ms, averaged over its first 0.2 s; the same over
-    2 s; the 46-element diagnosis's workers 1.06 s of CPU against 0.88 s)."""
-    from threadpoolctl import threadpool_info, threadpool_limits
-
-    more = sorted({i["prefix"] for i in threadpool_info() if (i["num_threads"] or 1) > 1})
-    return threadpool_limits(limits=dict.fromkeys(more, 1)) if more else \
-        contextlib.nullcontext()
 
 
 _BLAS_LIMIT = None
@@ -898,17 +884,6 @@ def _floor(fits) -> float:
     values = [f.misfit.chi2 / max(f.misfit.n_residuals - f.n_params, 1)
               for f in fits if f is not None and not f.failed and np.isfinite(f.misfit.chi2)]
     return max(1.0, min(values)) if values else 1.0
-
-
-def one_blas_thread(fn):
-    """Run ``fn`` with one BLAS thread, as the fit workers do: the same rounding in this
-    process as in theirs, whatever the machine's core count (an update reproduces the fit
-    its diagnosis made; a diagnosis does not hinge on how many threads BLAS took)."""
-    @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
-        with one_thread_limits():
-            return fn(*args, **kwargs)
-    return wrapper
 
 
 @one_blas_thread

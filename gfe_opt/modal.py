@@ -42,6 +42,7 @@ from .assembly import Discretisation, discretise
 from .errors import GfeInputError, GfeSolverError
 from .inputs import MAX_ELEMENTS
 from .model import Model
+from .threads import one_blas_thread
 
 #: Up to this many free DOFs a dense generalised eigensolver is used.
 DENSE_LIMIT = 1500
@@ -584,6 +585,7 @@ def rigid_body_count(disc) -> int:
     return disc.rigid_body_count()
 
 
+@one_blas_thread
 def model_modes(model: Model, n_modes: int) -> Modes:
     """The lowest ``n_modes`` modes of a model (all its effects included)."""
     return discretisation_modes(discretise(model), n_modes)

@@ -120,6 +120,7 @@ from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, observation, sensor_matrix
 from .model import Model
 from .parameterisation import Parameterisation, parameterisation_for
+from .threads import one_blas_thread
 
 METHODS = ("expand", "bilinear")
 SOLVERS = ("auto", "ipopt")
@@ -900,6 +901,7 @@ def _setup(model, parameterisation, regularisation, all_dofs_measured: bool):
     return disc, par, regularisation
 
 
+@one_blas_thread
 def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
                    parameterisation: str | Parameterisation = "nodal", method: str = "expand",
                    noise: float = DEFAULT_SHAPE_NOISE, regularisation: float | None = None,
