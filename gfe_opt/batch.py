@@ -90,6 +90,7 @@ def run_set(task: Task, name: str, data: bytes) -> dict:
     """One row: ``task`` on the measured file ``name`` with contents ``data``.  Never
     raises for a bad set (the row holds the error); runs serially in one BLAS thread."""
     from . import diagnosis
+    from .threads import one_thread_limits
 
     start = time.perf_counter()
     row = {"file": name, "sha1": hashlib.sha1(data).hexdigest(), "task": task.label,
@@ -97,7 +98,7 @@ def run_set(task: Task, name: str, data: bytes) -> dict:
     serial, diagnosis.SERIAL_FITS = diagnosis.SERIAL_FITS, True
     try:
         with tempfile.TemporaryDirectory(prefix=f"{TEMP_PREFIX}{os.getpid()}-") as tmp, \
-                diagnosis.one_thread_limits():
+                one_thread_limits():
             model_path = Path(tmp) / Path(task.model_name).name
             model_path.write_text(task.model_text)
             measured_path = Path(tmp) / Path(name).name
@@ -473,7 +474,7 @@ def _execute(task, todo, scheduler, workers, progress, skipped):
     context = multiprocessing.get_context("fork")
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                initializer=_ignore_sigint)
-    from .diagnosis import one_thread_limits
+    from .threads import one_thread_limits
 
     try:
         with one_thread_limits():   # the workers fork at the first submit and inherit it

@@ -6,7 +6,7 @@ import sys
 
 #: BLAS libraries' thread counts, set for this process before numpy loads (unless the user
 #: set them): every fit, diagnosis and update runs under one BLAS thread anyway
-#: (:func:`gfe_opt.diagnosis.one_blas_thread`, the workers), and a BLAS loaded with a pool
+#: (:func:`gfe_opt.threads.one_blas_thread`, the workers), and a BLAS loaded with a pool
 #: of threads made the fit workers forked from this process slower at the same work
 #: (measured: the 46-element diagnosis's workers 1.06 s of CPU against 0.88 s, the same
 #: results to the last digit; `gfe-opt diagnose` 1.43 -> 1.27 s)

@@ -44,7 +44,7 @@ POOL_THREADS_CODE = """
 import contextlib, json, os
 import numpy, scipy.linalg
 from threadpoolctl import threadpool_info
-from gfe_opt import diagnosis
+from gfe_opt import diagnosis, threads
 
 def blas_threads():
     return max(i["num_threads"] or 1 for i in threadpool_info() if i["user_api"] == "blas")
@@ -57,7 +57,7 @@ if blas_threads() == 1:
 else:
     for forked_under_one in (True, False):
         pool = diagnosis._new_pool(2)
-        limits = diagnosis.one_thread_limits if forked_under_one else contextlib.nullcontext
+        limits = threads.one_thread_limits if forked_under_one else contextlib.nullcontext
         with limits():
             futures = [pool.submit(worker, i) for i in range(2)]
         print(json.dumps([forked_under_one, sorted({f.result() for f in futures})]))
