@@ -56,6 +56,22 @@ def _same(a, b):
     assert [e.parameters for e in a.effects] == [e.parameters for e in b.effects]
 
 
+def _screened_as_every_point(monkeypatch, model, measured, name):
+    """``name`` fitted with its grid screened: it was screened, without falling back, and
+    the fit is the one with every point solved, to the last bit, in under half its full
+    solves."""
+    monkeypatch.setattr(fitting, "SCREEN", False)
+    plain = fitting.fit_effects(model, measured, [Effect(name, {})], noise=NOISE)
+    monkeypatch.setattr(fitting, "SCREEN", True)
+    before = dict(screening.TALLY)
+    fit = fitting.fit_effects(model, measured, [Effect(name, {})], noise=NOISE)
+    assert screening.TALLY["screened"] > before["screened"]
+    assert screening.TALLY["fallback"] == before["fallback"]
+    _same(plain, fit)
+    assert fit.evaluations < plain.evaluations / 2
+    return fit
+
+
 @pytest.mark.parametrize("name,place", [("crack", {"member": "beam"}),
                                         ("point_spring", {"member": "left-column",
                                                           "direction": "x"})])
@@ -106,15 +122,7 @@ def test_a_beam_grid_is_screened_place_by_place(monkeypatch, name):
     truth = model.with_elements(2 * model.elements).with_effects([hidden])
     measured = synthetic_measurement(truth, 4, interior_sensors(model.length, 15),
                                      shape_noise=0.003, freq_noise=0.0005, seed=5)
-    monkeypatch.setattr(fitting, "SCREEN", False)
-    plain = fitting.fit_effects(model, measured, [Effect(name, {})], noise=NOISE)
-    monkeypatch.setattr(fitting, "SCREEN", True)
-    before = dict(screening.TALLY)
-    fit = fitting.fit_effects(model, measured, [Effect(name, {})], noise=NOISE)
-    assert screening.TALLY["screened"] > before["screened"]
-    assert screening.TALLY["fallback"] == before["fallback"]
-    _same(plain, fit)
-    assert fit.evaluations < plain.evaluations / 2
+    fit = _screened_as_every_point(monkeypatch, model, measured, name)
     if name != "point_spring":
         assert fit.success and abs(fit.parameters["position"] - 0.3) < 0.01
     if name == "point_mass":
@@ -174,13 +182,5 @@ def test_a_condensed_beams_grid_is_screened_on_the_same_beam_solved_directly(mon
     screened = screening.screen(problem.residual, zs)
     assert screened is not None and len(zs) >= 15
     assert np.max(np.abs(screened / exact - 1)) < screening.MARGIN / 4
-    monkeypatch.setattr(fitting, "SCREEN", False)
-    plain = fitting.fit_effects(model, measured, [Effect(name, {})], noise=NOISE)
-    monkeypatch.setattr(fitting, "SCREEN", True)
-    before = dict(screening.TALLY)
-    fit = fitting.fit_effects(model, measured, [Effect(name, {})], noise=NOISE)
-    assert screening.TALLY["screened"] > before["screened"]
-    assert screening.TALLY["fallback"] == before["fallback"]
-    _same(plain, fit)
-    assert fit.evaluations < plain.evaluations / 2
+    fit = _screened_as_every_point(monkeypatch, model, measured, name)
     assert fit.success and abs(fit.parameters["position"] - 0.3) < 0.01
