@@ -798,8 +798,6 @@ def _single_threaded_blas():
     _BLAS_LIMIT = one_thread_limits()
 
 
-
-
 _BLAS_LIMIT = None
 #: fits one after another in this process (set by batch workers: the sets are the parallelism,
 #: and a Dask worker's daemon process may not fork)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import sys
 
 
 def one_thread_limits():
@@ -18,22 +19,26 @@ def one_thread_limits():
     call (threadpoolctl's limits, a context manager restoring them); a null context where
     every pool has one.  A count is never set again where it is one already: OpenBLAS
     restarts its pool of threads when its count is set in a process forked from one that
-    had the pool (a fit worker), and the new idle threads spin beside the worker for their
-    first fraction of a second (measured: a 92-DOF generalised eigensolve in two such
-    workers at once 0.76 ms against 0.54 ms, averaged over its first 0.2 s; the same over
-    2 s; the 46-element diagnosis's workers 1.06 s of CPU against 0.88 s)."""
+    had the pool (a fit worker: three OS threads in it instead of one), and the worker was
+    slower (measured: a 92-DOF generalised eigensolve in two such workers at once 0.76 ms
+    against 0.54 ms, averaged over its first 0.2 s; the same over 2 s; the 46-element
+    diagnosis's workers 1.06 s of CPU against 0.88 s).  The libraries are found once
+    (0.27 ms), and again when modules were imported since (one that loads its own BLAS);
+    a call then costs 10 µs."""
     global _CONTROLLER
-    if _CONTROLLER is None:   # built once (a quarter of a millisecond), then 10 µs a call
+    if _CONTROLLER is None or _CONTROLLER[0] != len(sys.modules):
         import scipy.linalg  # noqa: F401 (its BLAS loaded, to be controlled too)
         from threadpoolctl import ThreadpoolController
 
-        _CONTROLLER = ThreadpoolController()
-    more = sorted({c.prefix for c in _CONTROLLER.lib_controllers
+        _CONTROLLER = (len(sys.modules), ThreadpoolController())
+    controller = _CONTROLLER[1]
+    more = sorted({c.prefix for c in controller.lib_controllers
                    if (c.get_num_threads() or 1) > 1})
-    return _CONTROLLER.limit(limits=dict.fromkeys(more, 1)) if more else \
+    return controller.limit(limits=dict.fromkeys(more, 1)) if more else \
         contextlib.nullcontext()
 
 
+#: (len(sys.modules) when built, threadpoolctl's controller of the libraries loaded then)
 _CONTROLLER = None
 
 
