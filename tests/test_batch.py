@@ -309,4 +309,3 @@ def test_a_bars_csv_sets_are_read_as_its_axial_motion(tmp_path, capsys):
     assert main(["diagnose", str(model_path), str(tmp_path / "sets" / "a.csv"), "--json"]) == 0
     single = json.loads(capsys.readouterr().out)
     assert single["verdict"] == row["verdict"]
-
