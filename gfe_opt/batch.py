@@ -47,6 +47,7 @@ from pathlib import Path
 
 from .errors import GfeInputError
 from .outputs import check_output_path, create_exclusive, open_own
+from .threads import one_thread_limits
 
 MEASURED_SUFFIXES = (".json", ".csv", ".uff", ".unv")
 TABLE_SUFFIXES = (".parquet", ".csv")
@@ -90,7 +91,6 @@ def run_set(task: Task, name: str, data: bytes) -> dict:
     """One row: ``task`` on the measured file ``name`` with contents ``data``.  Never
     raises for a bad set (the row holds the error); runs serially in one BLAS thread."""
     from . import diagnosis
-    from .threads import one_thread_limits
 
     start = time.perf_counter()
     row = {"file": name, "sha1": hashlib.sha1(data).hexdigest(), "task": task.label,
@@ -474,8 +474,6 @@ def _execute(task, todo, scheduler, workers, progress, skipped):
     context = multiprocessing.get_context("fork")
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                initializer=_ignore_sigint)
-    from .threads import one_thread_limits
-
     try:
         with one_thread_limits():   # the workers fork at the first submit and inherit it
             futures = [pool.submit(run_set, task, name, data) for name, data in todo]

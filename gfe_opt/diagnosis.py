@@ -96,7 +96,7 @@ from .fitting import (
 from .measured import MeasuredModes
 from .model import Effect, Model, parse_effect
 from .structure import GENERIC_FAILURES, structure
-from .threads import one_blas_thread, one_thread_limits  # noqa: F401 (public here too)
+from .threads import one_blas_thread, one_thread_limits
 
 __all__ = ["DEFAULT_FREQ_NOISE", "DEFAULT_SHAPE_NOISE", "Diagnosis", "UpdateOutcome",
            "diagnose", "parse_effect", "update"]

@@ -9,7 +9,8 @@ import sys
 #: (:func:`gfe_opt.threads.one_blas_thread`, the workers), and a BLAS loaded with a pool
 #: of threads made the fit workers forked from this process slower at the same work
 #: (measured: the 46-element diagnosis's workers 1.06 s of CPU against 0.88 s, the same
-#: results to the last digit; `gfe-opt diagnose` 1.43 -> 1.27 s)
+#: results to the last digit; `gfe-opt diagnose` of a 46-element beam 1.40 -> 1.22 s, best
+#: of 5)
 BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
                 "VECLIB_MAXIMUM_THREADS")
 
