@@ -20,7 +20,7 @@ Measured (stop 75, seeds 1000-1039, 40 copies each): ``none`` rang in 24 of 160 
 0.035-0.17 to 0.009-0.032, the uniform loss's from 0.009-0.075 to 0.005-0.014; the crack's
 stayed (within ±0.04); the zone's median rose by 0.004-0.026.  Not adopted: with the rule
 the realisation's narrower noise band let systematic features through (a uniform E change
-read as a 2.6 % taper; see the README, Realisation).
+read as a 2-3 % taper; see the README, Realisation).
 """
 
 from __future__ import annotations
