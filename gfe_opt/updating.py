@@ -115,7 +115,7 @@ from scipy.sparse.linalg import splu, spsolve_triangular
 
 from . import elements as el
 from .assembly import Discretisation, discretise
-from .correlation import DEFAULT_SHAPE_NOISE, expand_modes
+from .correlation import DEFAULT_SHAPE_NOISE, discrepancy_factor, expand_modes
 from .errors import GfeInputError, GfeSolverError
 from .measured import MeasuredModes, observation, sensor_matrix
 from .model import Model
@@ -460,7 +460,13 @@ def _prepare(disc, par, measured, noise, regularisation, margin, q0, full_shapes
             expander, (K_exp, M_exp) = disc, (K_full, M_full)
         else:
             expander, (K_exp, M_exp) = expansion_disc, expansion_disc.global_matrices()
-        phi_full = expand_modes(expander, C_full, measured.omega, y, noise, K_exp, M_exp).shapes
+        # a beam's or bar's expansion at the noise norm the stated noise stays below, not
+        # its mean: at the mean the update rang on a sixth of noisy copies; a frame's at
+        # the mean (its members did not ring there, and the larger τ cost its readings:
+        # correlation.discrepancy_factor)
+        tau = 1.0 if frame else discrepancy_factor(y.shape[0])
+        phi_full = expand_modes(expander, C_full, measured.omega, y, noise * tau, K_exp,
+                                M_exp).shapes
     else:
         phi_full = np.asarray(full_shapes, float)
         if phi_full.shape != (disc.n_dof, measured.n_modes):

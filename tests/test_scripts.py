@@ -223,8 +223,9 @@ def test_following_the_finishes_changes_no_fit_and_records_what_they_reached():
 def test_study_discrepancy_shows_the_update_ringing_at_the_expected_noise_norm(tmp_path):
     """scripts/study_discrepancy.py: on 20 copies of a beam's own modes (45 sensors, 5 modes,
     0.3 % shape noise), the generic update with its expansion at the expected noise norm
-    (τ = 1, the package's) moves some node by more than 10 % on several copies; at the
-    97.5 % quantile of the noise norm on none, and its typical error is no larger."""
+    (τ = 1, the package's before stop 75) moves some node by more than 10 % on several
+    copies; at the 97.5 % quantile of the noise norm (the package's now) on none, and its
+    typical error is no larger."""
     out = _run("study_discrepancy.py", "--configs", "ss-46el-45s-5m", "--copies", "20",
                "--seed", "0", "--json", cwd=tmp_path)
     rows = {(r["truth"], r["tau"]): r for r in json.loads(out.strip().splitlines()[-1])}
