@@ -235,22 +235,19 @@ def test_study_discrepancy_shows_the_update_ringing_at_the_expected_noise_norm(t
     assert all(r["failed"] == 0 for r in rows.values())
 
 
-@pytest.mark.slow   # 9 diagnoses, 20-30 s; tests/test_realisation.py holds the disowned taper
+@pytest.mark.slow   # 8 diagnoses, 20-30 s; tests/test_realisation.py holds the disowned taper
 def test_bench_realisation_scores_the_words_on_truths_the_package_did_not_build(tmp_path):
-    """scripts/bench_realisation.py: E 4 % low (material, seed 1; a 1 200-element reference
-    beam) reads as one uniform change of EI below 1 that the material found reproduces; a
-    rising linear taper of the demo's beam (EI +30 %) as a rising taper the profile found
-    reproduces (it was disowned before stop 75)."""
-    out = _run("bench_realisation.py", "--seeds", "1", "--classes", "material,linear",
-               cwd=tmp_path)
+    """scripts/bench_realisation.py on the linear tapers of seed 1 (a 1 200-element reference
+    beam; EI 0.7-1.3 at the right end; the demo's beam and a 40-element clamped-free one):
+    each reads first as a taper of the truth's sign, which the profile found reproduces
+    (the rising ones were disowned before stop 75), with at most one feature beside it in
+    all eight."""
+    out = _run("bench_realisation.py", "--seeds", "1", "--classes", "linear", cwd=tmp_path)
     doc = json.loads(out.strip().splitlines()[-1])
-    rows = {r["name"]: r for r in doc["cases"]}
-    material = rows["material-clamped-pinned-1"]
-    assert material["first_right"] and material["spurious"] == 0
-    assert material["features"][0]["kind"] == "uniform" and material["features"][0]["value"] < 1
-    assert material["features"][0]["shown_by_finding"] is True
-    rising = rows["linear-1.3-pinned-pinned-46el-1"]
-    assert rising["suggested"] == ["stiffness_profile"] and rising["first_right"]
-    assert not rising["disowned"] and rising["features"][0]["shown_by_finding"] is True
+    assert len(doc["cases"]) == 8
+    for row in doc["cases"]:
+        assert row["suggested"] == ["stiffness_profile"], row["name"]
+        assert row["first_right"] and not row["disowned"], (row["name"], row["words"])
+        assert row["features"][0]["shown_by_finding"] is True, row["name"]
     card = doc["scorecard"]
-    assert card["all"]["cases"] == 1 + 8 and card["all"]["disowned"] == 0
+    assert card["linear"] == card["all"] and card["all"]["spurious"] <= 1
