@@ -113,9 +113,9 @@ def score(klass, want, features, unexplained, found, explains, element_length) -
         right = first is None
     else:
         kind, sign, place, half = want
-        change = (first.value - first.start) if first is not None and kind == "taper" else (
-            first.value - 1.0 if first is not None else 0.0)
-        right = (first is not None and first.kind == kind and np.sign(change) == sign
+        right = (first is not None and first.kind == kind
+                 # a taper's change is end against start; any other feature's against 1
+                 and np.sign(first.value - (first.start if kind == "taper" else 1.0)) == sign
                  and (place is None or abs(first.x - place) <= half + 2 * element_length))
     spurious = len(features) - (1 if right and want is not None else 0)
     disowned = bool(right and want is not None and found & FAMILY[klass] and explains
