@@ -568,8 +568,14 @@ def local_difference(models, weights, index: int):
     elements that effect changes in any of them and its nodal springs: elsewhere the terms
     are the same numbers and cancel exactly.  Dense up to :data:`DENSE_DIFFERENCE_DOFS`,
     else sparse.  None where the difference is not local: an effect on every element (a
-    uniform factor, an element term, E), a shear beam (its g couples the sensors' reading
-    to the elements) or a plane frame."""
+    uniform factor, an element term, E) or a shear beam (its g couples the sensors' reading
+    to the elements).  Plane frames: :func:`gfe_opt.frame.local_difference` (sparse)."""
+    if any(m.kind == "frame" for m in models):
+        if not all(m.kind == "frame" for m in models):
+            return None
+        from .frame import local_difference as frame_difference
+
+        return frame_difference(models, weights, index)
     if any(m.kind not in ("beam", "bar") for m in models) or len(
             {m.youngs_modulus for m in models}) > 1:
         return None

@@ -1001,6 +1001,67 @@ def _outer_sum(C, values) -> sp.csr_matrix:
     return sp.csr_matrix((out[i, j], (cols[i], cols[j])), shape=(C.shape[1], C.shape[1]))
 
 
+def local_difference(models, weights, index: int):
+    """Σ wᵢ K(modelsᵢ) and Σ wᵢ M(modelsᵢ) (all DOFs, sparse) of frames that differ only in
+    their effect ``index`` (a fit's Jacobian differencing one variable's matrices), from
+    what that effect changes alone: the elements of its member (an element effect), or its
+    own outer product (a point mass or spring).  :func:`frame_matrices`' other terms are the
+    same numbers in every model and cancel; building them for each model was a tenth of a
+    three-storey frame's diagnosis.  None where the effect changes the mesh's springs (a
+    joint or a support), every member (the material, shear) or how the members read
+    (Timoshenko members), or where the models' meshes differ: the caller then differences
+    the whole matrices, as :func:`gfe_opt.assembly.local_difference` does on a beam."""
+    first = models[0]
+    name = first.effects[index].name
+    local = name in _ELEMENT_EFFECTS or name in ("point_mass", "point_spring")
+    if not local or name == "member_shear" or any(has_shear(m) for m in models):
+        return None
+    meshes = [frame_mesh(m) for m in models]
+    mesh = meshes[0]
+    if any(x.n_dof != mesh.n_dof or not np.array_equal(x.element_dofs, mesh.element_dofs)
+           for x in meshes[1:]):
+        return None
+    n = mesh.n_dof
+
+    def weighted(values):
+        """Σ wᵢ (vᵢ − v_last) (the weights of a derivative sum to zero)."""
+        out = weights[0] * (values[0] - values[-1])
+        for w, v in zip(weights[1:-1], values[1:-1]):
+            out = out + w * (v - values[-1])
+        return out
+
+    if name in _ELEMENT_EFFECTS:
+        member = first.effects[index].parameters["member"]
+        k = next(i for i, m in enumerate(first.members) if m.id == member)
+        start = sum(m.elements for m in first.members[:k])
+        stop = start + first.members[k].elements
+        if not np.all(mesh.element_member[start:stop] == k):
+            return None
+        parts = [member_elements(m)[k] for m in models]
+        dofs = mesh.element_dofs[start:stop]
+        rows = np.repeat(dofs, 6, axis=1).ravel()
+        cols = np.tile(dofs, (1, 6)).ravel()
+        return tuple(sp.csr_matrix((weighted([getattr(p, which) for p in parts]).ravel(),
+                                    (rows, cols)), shape=(n, n)) for which in ("K", "M"))
+    from .frame_data import attached_reading
+
+    parts = []
+    for m, x in zip(models, meshes):
+        e = m.raw_effects[index]
+        if name == "point_mass":
+            places = [{"member": e["member"], "position": e["position"], "direction": d}
+                      for d in ("x", "y")]
+            values = np.repeat([e["mass"]], 2)
+        else:
+            places = [{"member": e["member"], "position": e["position"],
+                       "direction": e["direction"]}]
+            values = np.array([float(e["stiffness"])])
+        parts.append(_outer_sum(attached_reading(m, x, places), values))
+    change = sp.csr_matrix(weighted(parts))
+    zero = sp.csr_matrix((n, n))
+    return (zero, change) if name == "point_mass" else (change, zero)
+
+
 def _assemble(mesh: FrameMesh, which: str, values) -> sp.csr_matrix:
     """The sparse sum of ``values`` over the mesh's entries (``"K"``: the elements' 36 a
     element, then each joint spring's four, then each ground spring's one; ``"M"``: the
