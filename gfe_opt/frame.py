@@ -1037,12 +1037,17 @@ def local_difference(models, weights, index: int):
         stop = start + first.members[k].elements
         if not np.all(mesh.element_member[start:stop] == k):
             return None
-        parts = [member_elements(m)[k] for m in models]
-        dofs = mesh.element_dofs[start:stop]
+        along = _footprint(models, index, k)
+        if along is None:   # (every element of the member)
+            parts = [(p.K, p.M) for p in (member_elements(m)[k] for m in models)]
+            along = np.arange(stop - start)
+        else:
+            parts = [_some_elements(m, k, along) for m in models]
+        dofs = mesh.element_dofs[start + along]
         rows = np.repeat(dofs, 6, axis=1).ravel()
         cols = np.tile(dofs, (1, 6)).ravel()
-        return tuple(sp.csr_matrix((weighted([getattr(p, which) for p in parts]).ravel(),
-                                    (rows, cols)), shape=(n, n)) for which in ("K", "M"))
+        return tuple(sp.csr_matrix((weighted([p[which] for p in parts]).ravel(),
+                                    (rows, cols)), shape=(n, n)) for which in (0, 1))
     from .frame_data import attached_reading
 
     parts = []
@@ -1060,6 +1065,45 @@ def local_difference(models, weights, index: int):
     change = sp.csr_matrix(weighted(parts))
     zero = sp.csr_matrix((n, n))
     return (zero, change) if name == "point_mass" else (change, zero)
+
+
+def _footprint(models, index: int, k: int) -> np.ndarray | None:
+    """The elements of member ``k`` (sorted, along it) that effect ``index`` changes in any
+    of ``models`` (:meth:`~gfe_opt.assembly.Builder.footprint` of its member's two lines
+    with that effect alone), or None when it changes all of them (a profile, a tension, a
+    foundation, a looser member: its footprint is the member)."""
+    from .assembly import builder
+
+    out = []
+    for m in models:
+        effect = m.effects[index]
+        if effect.name == "axial_stiffness":
+            return None
+        alone = replace(m, effects=(effect,))
+        for line in member_lines(alone, alone.members[k]):
+            part = builder(line).footprint()
+            if part is None:
+                return None
+            out.append(part)
+    return np.unique(np.concatenate(out)).astype(int) if out else np.zeros(0, dtype=int)
+
+
+def _some_elements(model: FrameModel, k: int, along: np.ndarray):
+    """(K, M) in global axes of the elements ``along`` member ``k``: the numbers
+    :func:`_member_elements` gives them, without building the others."""
+    from .assembly import builder
+
+    member = model.members[k]
+    beam, bar = member_lines(model, member)
+    bending, axial = builder(beam), builder(bar)
+    static = _member_static(model, member, bending, axial)
+    k_beam, extra, m_beam = bending.element_matrices(along)
+    k_bar, _, m_bar = axial.element_matrices(along)
+    T, Tt = static.T[along], static.Tt[along]
+    K = Tt @ _local(k_bar, k_beam + extra) @ T
+    M = static.M[along] if not (bending.mass or axial.mass) else \
+        Tt @ _local(m_bar, m_beam) @ T
+    return K, M
 
 
 def _assemble(mesh: FrameMesh, which: str, values) -> sp.csr_matrix:
