@@ -66,9 +66,11 @@ def profile_with_band(band, label=None, *, length=None, supports=("pinned", "pin
         ax, sketch = fig.subplots(2, 1, sharex=True, height_ratios=(3.4, 1.1))
     else:
         ax, sketch = fig.add_subplot(), None
-    _profile_panel(ax, band, label)
+    _profile_panel(ax, band, label, quantity=band.quantity)
     _legend_below(fig, ax)
-    ax.set_title("Bending stiffness read from the test at each node, over the model's",
+    ax.set_title("Bending stiffness read from the test at each node, over the model's"
+                 if band.quantity == "EI" else
+                 "Axial stiffness read from the test at each element, over the model's",
                  fontsize=10)
     if sketch is not None:
         structure_sketch(sketch, length, supports, places=places, findings=findings,

@@ -339,6 +339,9 @@ class ProfileBand:
     null: np.ndarray
     explained: np.ndarray | None = None
     unexplained: tuple = ()
+    #: what was read: "EI" (a beam's bending, at its nodes) or "EA" (a bar's axial, at its
+    #: elements' middles)
+    quantity: str = "EI"
 
 
 def _generic_ratio_of(disc, data, noise, n):
@@ -355,7 +358,22 @@ def _generic_ratio_of(disc, data, noise, n):
         result = update_generic(disc, data, noise=max(noise.shape, 1e-3))
     except (ValueError, np.linalg.LinAlgError):
         return None
-    return result.q[:n + 1] / result.q0[:n + 1] if result.ok else None
+    if not result.ok:
+        return None
+    if disc.kind == "bar":
+        return _element_values(result.q[:n + 1]) / _element_values(result.q0[:n + 1])
+    return result.q[:n + 1] / result.q0[:n + 1]
+
+
+def _element_values(nodal: np.ndarray) -> np.ndarray:
+    """A bar's element EA from its nodal values (eq. 7, c1 = c2 = 1/2), the way a bar is
+    read: the nodal values themselves have a null space, the vector alternating +a, −a from
+    node to node, which changes no element, and the regularisation alone holds it.  It did
+    not hold it on a fixed-free bar (the free end's nodes, which the data leave open, pulled
+    it out): nodes read 1.09 and 0.92 of the model's in turn along the whole bar of the
+    model's own modes, where its elements read 1.000 ± 0.005 (the ``bar-*`` rows of
+    ``scripts/study_discrepancy.py``; a frame's members are read so, axially, already)."""
+    return 0.5 * (nodal[1:] + nodal[:-1])
 
 
 def _profile_size(disc) -> int:
@@ -363,7 +381,7 @@ def _profile_size(disc) -> int:
     member's own nodes on a frame (a joint once per member)."""
     if disc.kind == "frame":   # bending at the nodes, then axial at the elements
         return sum(2 * m.elements + 1 for m in disc.model.members)
-    return disc.n_elements + 1
+    return disc.n_elements + (disc.kind != "bar")   # a bar at its elements
 
 
 def vibrating_modes(disc: Discretisation, n_modes: int):
@@ -421,10 +439,15 @@ def profile_band(disc: Discretisation, measured, result, noise, samples: int = B
     null, sigma = draws_summary(draws, _profile_size(disc))
     if disc.kind == "frame":
         return _frame_band(disc, result, null, sigma, measured.n_modes)
-    ratio = result.q[:n + 1] / result.q0[:n + 1] / null
+    x, quantity = np.asarray(disc.nodes, dtype=float), "EI"
+    ratio = result.q[:n + 1] / result.q0[:n + 1]
+    if disc.kind == "bar":   # its elements (_element_values), at their middles
+        x, quantity = 0.5 * (x[1:] + x[:-1]), "EA"
+        ratio = _element_values(result.q[:n + 1]) / _element_values(result.q0[:n + 1])
+    ratio = ratio / null
     sigma = np.where(_determined(disc, own), sigma, np.inf)
-    trend, features = _features(disc.nodes, ratio, sigma, measured.n_modes)
-    return ProfileBand(disc.nodes, ratio, sigma, trend, tuple(features), null)
+    trend, features = _features(x, ratio, sigma, measured.n_modes)
+    return ProfileBand(x, ratio, sigma, trend, tuple(features), null, quantity=quantity)
 
 
 @dataclass(frozen=True)
@@ -601,8 +624,8 @@ def _determined(disc: Discretisation, measured) -> np.ndarray:
     """Nodes whose bending stiffness the measured modes determine: the mean over modes of
     (curvature at the node / the mode's largest curvature)² at least 1 %.  At a pinned or
     free end the moment, and with it what the data say about k, vanishes."""
-    if disc.kind != "beam":
-        return np.ones(len(disc.nodes), dtype=bool)
+    if disc.kind != "beam":   # (a bar is read at its elements)
+        return np.ones(_profile_size(disc), dtype=bool)
     modes = vibrating_modes(disc, measured.n_modes)
     L = disc.element_length
     u = modes.shapes[disc.element_dofs()] * el.beam_dof_scaling(L)[None, :, None]
@@ -692,7 +715,8 @@ def describe_profile(band: ProfileBand, effect: str | None = None,
         finite = band.sigma[np.isfinite(band.sigma)]
         width = 100 * FEATURE_SIGMAS * float(np.median(finite)) if finite.size else 0.0
         what = ("bending or axial stiffness of any member" if isinstance(
-            band, FrameProfileBand) else "bending stiffness")
+            band, FrameProfileBand) else "axial stiffness" if band.quantity == "EA" else
+            "bending stiffness")
         return [f"no change of the {what} beyond the noise band (±{width:.1f} %)"]
     if isinstance(band, FrameProfileBand):
         ends = {m.id: (m.start, m.end) for m in band.model_members}
@@ -709,7 +733,7 @@ def describe_profile(band: ProfileBand, effect: str | None = None,
         unexplained = [(m, f, what) for m, _, f, what in band.unexplained]
         explained = band.members[0][2].explained is not None
     else:
-        features = [(f, f.describe()) for f in band.features]
+        features = [(f, f.describe(quantity=band.quantity)) for f in band.features]
         unexplained, explained = band.unexplained, band.explained is not None
     if effect is None or not explained:
         return [text for _, text in features]
