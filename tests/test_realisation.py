@@ -191,9 +191,9 @@ def test_a_bar_is_read_at_its_elements_where_its_nodal_values_have_a_null_space(
     of the model's in turn along the whole bar.  Read at the elements, the profile is
     flat to the discretisation's own error (within 1 % over the first three quarters),
     except towards the free end, where the data leave EA open."""
+    from gfe_opt.fitting import Noise
     from gfe_opt.measured import make_measured
     from gfe_opt.realisation import generic_ratio
-    from gfe_opt.fitting import Noise
 
     from .conftest import STEEL_BAR
     from .reference import ReferenceBar, interior
