@@ -1091,11 +1091,18 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
             # the steps fail where the finish predicts a gain worth having: a kink of χ²
             # the slopes averaged across (:func:`_kinks`)?  Its variables are then held
             # where χ² rises both ways, and the others converge without them
-            kinked, gain = _kinks(residual, z, value, free, lower, upper, span)
+            kinked, gain, lower_point = _kinks(residual, z, value, free, lower, upper, span)
             if kinked.any() and kink_gain + gain < FINISH_SETTLED * floor:
                 on_kink |= kinked
                 kink_gain += gain
                 S, lam = np.zeros((n, n)), 0.0
+                continue
+            if lower_point is not None:
+                # a probe lowered χ² (towards a kink the slopes do not show yet): a step
+                z, r = lower_point
+                value = float(r @ r)
+                J = _jacobian(residual, z, r, lower, upper)
+                pairing, S, lam = _pairing(residual), np.zeros((n, n)), 0.0
                 continue
         if not accepted:  # no step lowers χ²: the optimum as far as rounding can tell
             return z, value, decrement / floor
@@ -1143,14 +1150,20 @@ def _decrement(Ju, g, r, S, free):
 
 #: a kink is probed by steps of these fractions of a variable's range, the smallest first
 KINK_STEPS = (1e-7, 1e-6, 1e-5)
+#: ... and is one where χ²'s slope turns across it by more than this many times it turns
+#: over a step on one side (a smooth minimum turns it alike on every step: ratio 1)
+KINK_RATIO = 100.0
 
 
 def _kinks(residual, z, value, free, lower, upper, span):
-    """The ``free`` variables along which χ² has its minimum within a probe's step of ``z``
-    (χ² at z ± h, z ± 2h: slopes nondecreasing, none negative ahead nor positive behind;
-    h each of :data:`KINK_STEPS` of the range in turn), and the χ² that minimum may lie
-    below χ²(z), summed over them: at most h max(|slope behind|, |slope ahead|) each, χ²
-    being convex along the variable there (its slopes say so).
+    """The ``free`` variables along which χ² has a kink and its minimum within a probe's
+    step of ``z`` (χ² at z ± h, z ± 2h: slopes nondecreasing, none negative ahead nor
+    positive behind, turning between the middle two by more than :data:`KINK_RATIO` times
+    on a step beside them; h each of :data:`KINK_STEPS` of the range in turn), the χ²
+    that minimum may lie below
+    χ²(z), summed over them (at most h max(|slope behind|, |slope ahead|) each, χ² being
+    convex along the variable there, as its slopes say), and the lowest probe, ``(z, r)``,
+    where one lies below χ²(z) (None otherwise; the variables are then not read).
 
     A zone whose edge lies on a node of the mesh (a 0.2 m zone from 0.6 m on a bar of
     0.05 m elements): an element's stiffness follows the part of it the zone covers, so
@@ -1161,6 +1174,7 @@ def _kinks(residual, z, value, free, lower, upper, span):
     short of the node) ended ``not_converged`` at 0.04 noise floors, and the diagnosis
     said that nothing explained the test (issue 21's second-worst answer)."""
     kinked, gain = np.zeros(z.size, dtype=bool), 0.0
+    best = None
     for k in np.flatnonzero(free):
         for fraction in KINK_STEPS:
             h = fraction * span[k]
@@ -1172,15 +1186,22 @@ def _kinks(residual, z, value, free, lower, upper, span):
                 trial[k] += step
                 r_trial = residual(trial)
                 values.append(float(r_trial @ r_trial))
+                if values[-1] < value and (best is None or values[-1] < best[0]):
+                    best = (values[-1], trial, r_trial)
             if not np.all(np.isfinite(values)):
                 break
             back2, back, ahead, ahead2 = values
             slopes = np.array([back - back2, value - back, ahead - value, ahead2 - ahead]) / h
-            if slopes[1] <= 0.0 <= slopes[2] and np.all(np.diff(slopes) >= 0.0):
+            turn = np.diff(slopes)   # a kink turns the slope between the middle two
+            if slopes[1] <= 0.0 <= slopes[2] and np.all(turn >= 0.0) and \
+                    turn[1] > KINK_RATIO * min(turn[0], turn[2]):
                 kinked[k] = True
                 gain += h * max(-slopes[1], slopes[2])
                 break
-    return kinked, gain
+    if best is not None:
+        residual(best[1])   # (the residual's pairing is the point's)
+        return kinked, gain, (best[1], best[2])
+    return kinked, gain, None
 
 
 def _on_bounds(z, lower, upper, span):

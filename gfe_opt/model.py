@@ -421,7 +421,9 @@ def model_to_dict(model: Model) -> dict:
     if model.breadth is not None and model.depth is not None:
         data["section"] = {"shape": "rectangle", "b": model.breadth, "h": model.depth}
     else:
-        data["section"] = {"A": model.area, "I": model.inertia}
+        data["section"] = {"A": model.area}
+        if model.kind != "bar" or model.inertia > 0:   # (a bar's file may leave I out)
+            data["section"]["I"] = model.inertia
         if model.depth is not None:
             data["section"]["h"] = model.depth
     data["supports"] = {"left": model.supports[0], "right": model.supports[1]}

@@ -208,7 +208,9 @@ def format_diagnosis(result, model) -> str:
     if words and words[0].startswith("the generic-element update"):
         lines += words[:1] + [f"  {w}" for w in words[1:]]
     elif words:
-        lines.append("the generic-element update (nodal k_i, no physical effect assumed):")
+        read = ("the elements' EA" if getattr(getattr(result, "profile_band", None),
+                                               "quantity", "EI") == "EA" else "nodal k_i")
+        lines.append(f"the generic-element update ({read}, no physical effect assumed):")
         lines += [f"  - {word}" for word in words]
     lines += [f"note: {n}" for n in result.notes]
     lines.append(f"({result.seconds:.1f} s)")

@@ -288,6 +288,17 @@ def test_a_model_file_keeps_which_effects_were_found(tmp_path):
     save_model(frame, tmp_path / "f.toml")
     assert [e.found for e in load_model(tmp_path / "f.toml", frames=True).effects] == [
         True, False]
+    # a bar's file gives A alone: what update writes for it reads back (it wrote I = 0,
+    # which the reader refuses)
+    from .conftest import STEEL_BAR
+
+    bar = make_model(STEEL_BAR).with_effects([Effect(
+        "section_loss", {"position": 0.7, "length": 0.2, "stiffness_ratio": 0.8,
+                         "mass_ratio": 1.0}, found=True)])
+    save_model(bar, tmp_path / "b.toml")
+    from dataclasses import replace
+
+    assert replace(load_model(tmp_path / "b.toml"), source=bar.source) == bar
 
 
 def test_data_the_model_fits_are_consistent_and_no_support_effect_is_called():

@@ -216,7 +216,9 @@ class SectionLoss(EffectType):
         c, ell = params["position"], params["length"]
         ax.plot([c - ell / 2, c + ell / 2], [0.0, 0.0], lw=9, color="tab:orange",
                 solid_capstyle="butt", zorder=4)  # the zone on the beam
-        ax.annotate(f"EI×{params['stiffness_ratio']:.2f}, ρA×{params['mass_ratio']:.2f}",
+        rigidity = "EA" if getattr(model, "kind", None) == "bar" else "EI"
+        ax.annotate(f"{rigidity}×{params['stiffness_ratio']:.2f}, "
+                    f"ρA×{params['mass_ratio']:.2f}",
                     (c, y), textcoords="offset points", xytext=(0, 9), ha="center",
                     fontsize=7, color="tab:orange")
 
