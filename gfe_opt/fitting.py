@@ -1022,7 +1022,13 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     which looks past the seam, stays high: an end that is ``not_converged`` either way (on
     the three-storey frame's diagnosis such creeps took 900 of its 1 471 Jacobians).  One
     such step is not enough: after many rejections one small step, then steps that gain
-    again, is how three of the semi-rigid portal's fits leave a seam and converge.  Returns
+    again, is how three of the semi-rigid portal's fits leave a seam and converge.
+
+    Where no step lowers χ² while the decrement still predicts a gain above
+    :data:`FINISH_SETTLED` floors, the variables are probed for a kink of χ² (a zone's
+    edge on a node: :func:`_kinks`): one found is held where χ² rises both ways, the χ²
+    it may still hide counted in the decrement, and the others go on; a probe that
+    lowers χ² is a step.  Returns
     (z, χ², the last decrement in noise floors: 0 when nothing was left to fit, inf when the
     fit could not be evaluated)."""
     n = z.size
@@ -1148,10 +1154,15 @@ def _decrement(Ju, g, r, S, free):
     return decrement, sv, V, gk, H, lowest_eig
 
 
-#: a kink is probed by steps of these fractions of a variable's range, the smallest first
+#: a kink is probed by steps of these fractions of a variable's range, the smallest first:
+#: from where χ² still moves far above its rounding (a slope of 1 moves it by 1e-7, its
+#: rounding 1e-13 relative) up to the Jacobian's own difference step (1e-5), the scale on
+#: which a kink corrupts the slopes the finish steps along
 KINK_STEPS = (1e-7, 1e-6, 1e-5)
 #: ... and is one where χ²'s slope turns across it by more than this many times it turns
-#: over a step on one side (a smooth minimum turns it alike on every step: ratio 1)
+#: over a step on one side: a smooth χ² turns it alike on every step (ratio 1 for a
+#: quadratic), a kink by its jump, which the step does not shrink (ratio ~ jump / (χ'' h):
+#: 1e3 and more at these steps); 100 lies between, not tuned
 KINK_RATIO = 100.0
 
 
