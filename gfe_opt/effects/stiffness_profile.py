@@ -24,8 +24,8 @@ class StiffnessProfile(ProfileEffect):
         with knots x (least squares)."""
         if band is None:
             return None
-        if member is None:
-            nodes, ratio = model.nodes, band.ratio
+        if member is None:   # (where the band reads: a beam's nodes, a bar's elements)
+            nodes, ratio = band.x, band.ratio
         else:   # a frame's band: the member's bending reading
             part = next(b for m, _, b, what in band.members if m == member and what == "EI")
             nodes, ratio = part.x, part.ratio
