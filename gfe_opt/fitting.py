@@ -1043,8 +1043,9 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
     S = np.zeros((n, n))          # Σ rᵢ∇²rᵢ in the scaled variables (secant estimate)
     lam = 0.0
     span = np.maximum(upper - lower, 1e-300)
-    # variables held on a kink of χ² (:func:`_kinks`) and the χ² the kinks may still hide
-    on_kink, kink_gain = np.zeros(n, dtype=bool), 0.0
+    # variables held on a kink of χ² (:func:`_kinks`), the χ² the kinks may still hide and
+    # the steps taken to a probe
+    on_kink, kink_gain, probe_steps = np.zeros(n, dtype=bool), 0.0, 0
     for _ in range(steps):
         Ju = J / d
         g = Ju.T @ r
@@ -1103,8 +1104,11 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
                 kink_gain += gain
                 S, lam = np.zeros((n, n)), 0.0
                 continue
-            if lower_point is not None:
-                # a probe lowered χ² (towards a kink the slopes do not show yet): a step
+            if lower_point is not None and probe_steps < len(KINK_STEPS):
+                # a probe lowered χ² (towards a kink the slopes do not show yet): a step.
+                # Each brings a kink within the next smaller probe's reach, so the ladder's
+                # length of them reaches any; more would only creep along a valley
+                probe_steps += 1
                 z, r = lower_point
                 value = float(r @ r)
                 J = _jacobian(residual, z, r, lower, upper)
