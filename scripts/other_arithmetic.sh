@@ -26,6 +26,7 @@ DECISIONS=(
     tests/test_frame_profile.py
     tests/test_realisation.py
     tests/test_screening.py
+    tests/test_fitting_numerics.py
     tests/test_scripts.py::test_shipped_examples_are_what_the_script_writes
     tests/test_cli.py::test_demo_tells_the_whole_story_and_refuses_to_overwrite
 )
