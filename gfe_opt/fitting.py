@@ -1060,9 +1060,9 @@ def _finish(residual, z, value, lower, upper, steps: int = FINISH_STEPS):
         if not free.any():
             return z, value, kink_gain / floor
         decrement, sv, V, gk, H, lowest_eig = _decrement(Ju, g, r, S, free)
+        if decrement < FINISH_DECREMENT * floor:   # (what kinks held may hide, reported)
+            return z, value, max(decrement, kink_gain) / floor
         decrement = max(decrement, kink_gain)
-        if decrement < FINISH_DECREMENT * floor:
-            return z, value, decrement / floor
         shift = max(0.0, -lowest_eig) + 1e-12 * sv[0] ** 2   # H + shift: positive definite
         accepted = False
         seams = others = 0   # rejected trials across a seam of the pairing, and the others
