@@ -603,7 +603,7 @@ def local_difference(models, weights, index: int):
     # part the effect leaves alone (the beam's own stiffness under a point spring, a spring
     # on a held DOF) is then exactly zero instead of rounding
     def weighted(values):
-        return sum(w * (v - values[-1]) for w, v in zip(weights[:-1], values[:-1]))
+        return weighted_difference(values, weights)
 
     parts = [build.element_matrices(elements) for build in builds] if elements.size else []
     dK, dM = ((weighted([p[0] for p in parts]) + weighted([p[1] for p in parts]),
@@ -623,6 +623,17 @@ def local_difference(models, weights, index: int):
                      for v in (values, mass_values))
     return tuple(sp.csr_matrix((v, (rows, cols)), shape=(n_dof, n_dof))
                  for v in (values, mass_values))
+
+
+def weighted_difference(values, weights):
+    """Σ wᵢ (vᵢ − v_last) of ``values`` (numbers, arrays or sparse matrices) with a
+    derivative's ``weights``, which sum to zero: Σ wᵢ vᵢ with each term taken against the
+    last, so that a part every value shares cancels exactly (:func:`local_difference`,
+    :func:`gfe_opt.frame.local_difference`)."""
+    out = weights[0] * (values[0] - values[-1])
+    for w, v in zip(weights[1:-1], values[1:-1]):
+        out = out + w * (v - values[-1])
+    return out
 
 
 def discretise(model: Model) -> Discretisation:

@@ -1023,12 +1023,10 @@ def local_difference(models, weights, index: int):
         return None
     n = mesh.n_dof
 
+    from .assembly import weighted_difference
+
     def weighted(values):
-        """Σ wᵢ (vᵢ − v_last) (the weights of a derivative sum to zero)."""
-        out = weights[0] * (values[0] - values[-1])
-        for w, v in zip(weights[1:-1], values[1:-1]):
-            out = out + w * (v - values[-1])
-        return out
+        return weighted_difference(values, weights)
 
     if name in _ELEMENT_EFFECTS:
         member = first.effects[index].parameters["member"]
