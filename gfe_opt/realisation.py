@@ -344,7 +344,7 @@ class ProfileBand:
     quantity: str = "EI"
 
 
-def _generic_ratio_of(disc, data, noise, n):
+def _generic_ratio_of(disc, data, noise):
     from .updating import update_generic
 
     try:
@@ -358,23 +358,27 @@ def _generic_ratio_of(disc, data, noise, n):
         result = update_generic(disc, data, noise=max(noise.shape, 1e-3))
     except (ValueError, np.linalg.LinAlgError):
         return None
-    if not result.ok:
-        return None
-    if disc.kind == "bar":
-        return _element_values(result.q[:n + 1]) / _element_values(result.q0[:n + 1])
-    return result.q[:n + 1] / result.q0[:n + 1]
+    return _line_reading(disc, result)[1] if result.ok else None
 
 
-def _element_values(nodal: np.ndarray) -> np.ndarray:
-    """A bar's element EA from its nodal values (eq. 7, c1 = c2 = 1/2), the way a bar is
-    read: the nodal values themselves have a null space, the vector alternating +a, −a from
-    node to node, which changes no element, and the regularisation alone holds it.  It did
-    not hold it on a fixed-free bar (the free end's nodes, which the data leave open, pulled
-    it out): nodes read 1.09 and 0.92 of the model's in turn along the whole bar of the
-    model's own modes, where its elements read within 0.9 % of 1 over its first three
-    quarters (the free end's, which the data leave open, falls to 0.57; the ``bar-*`` rows of
+def _line_reading(disc, result):
+    """(x, k / k0, quantity) of a beam's or bar's generic update: a beam's nodal k_i at its
+    nodes ("EI"); a bar's element EA, as its parameterisation makes them of its nodal
+    values (eq. 7), at the elements' middles ("EA").  A bar is read at its elements: its
+    nodal values have a null space, the vector alternating +a, −a from node to node, which
+    changes no element, and the regularisation alone holds it.  It did not hold it on a
+    fixed-free bar (the free end's nodes, which the data leave open, pulled it out): nodes
+    read 1.09 and 0.92 of the model's in turn along the whole bar of the model's own
+    modes, where its elements read within 0.9 % of 1 over its first three quarters (the
+    free end's, which the data leave open, falls to 0.57; the ``bar-*`` rows of
     ``scripts/study_discrepancy.py``; a frame's members are read so, axially, already)."""
-    return 0.5 * (nodal[1:] + nodal[:-1])
+    n = disc.n_elements
+    x = np.asarray(disc.nodes, dtype=float)
+    q, q0 = result.q[:n + 1], result.q0[:n + 1]
+    if disc.kind == "bar":
+        A = result.parameterisation.matrix
+        return 0.5 * (x[1:] + x[:-1]), (A @ q) / (A @ q0), "EA"
+    return x, q / q0, "EI"
 
 
 def _profile_size(disc) -> int:
@@ -433,18 +437,13 @@ def profile_band(disc: Discretisation, measured, result, noise, samples: int = B
     ``draws``: the updates (:func:`generic_ratio`) of :func:`noisy_copies` ``(disc,
     measured, noise, samples, seed)`` already run (in parallel, by the diagnosis); None
     runs them here."""
-    n = disc.n_elements
     own = own_modes(disc, measured)
     if draws is None:
         draws = [generic_ratio(disc, c, noise) for c in _copies(own, noise, samples, seed)]
     null, sigma = draws_summary(draws, _profile_size(disc))
     if disc.kind == "frame":
         return _frame_band(disc, result, null, sigma, measured.n_modes)
-    x, quantity = np.asarray(disc.nodes, dtype=float), "EI"
-    ratio = result.q[:n + 1] / result.q0[:n + 1]
-    if disc.kind == "bar":   # its elements (_element_values), at their middles
-        x, quantity = 0.5 * (x[1:] + x[:-1]), "EA"
-        ratio = _element_values(result.q[:n + 1]) / _element_values(result.q0[:n + 1])
+    x, ratio, quantity = _line_reading(disc, result)
     ratio = ratio / null
     sigma = np.where(_determined(disc, own), sigma, np.inf)
     trend, features = _features(x, ratio, sigma, measured.n_modes)
@@ -554,7 +553,7 @@ def _copies(own, noise, samples, seed) -> list:
 def generic_ratio(disc: Discretisation, data, noise):
     """One draw: the generic update of ``data`` on ``disc`` as k_i / k_i0 (None if it
     fails)."""
-    return _generic_ratio_of(disc, data, noise, disc.n_elements)
+    return _generic_ratio_of(disc, data, noise)
 
 
 def draws_summary(draws, size: int):
