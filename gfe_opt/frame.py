@@ -1006,8 +1006,9 @@ def local_difference(models, weights, index: int):
     their effect ``index`` (a fit's Jacobian differencing one variable's matrices), from
     what that effect changes alone: the elements of its member (an element effect), or its
     own outer product (a point mass or spring).  :func:`frame_matrices`' other terms are the
-    same numbers in every model and cancel; building them for each model was a tenth of a
-    three-storey frame's diagnosis.  None where the effect changes the mesh's springs (a
+    same numbers in every model and cancel (building them for each model was a tenth of a
+    three-storey frame's diagnosis under the profiler; its wall time did not measurably
+    change: the README's Speed section).  None where the effect changes the mesh's springs (a
     joint or a support), every member (the material, shear) or how the members read
     (Timoshenko members), or where the models' meshes differ: the caller then differences
     the whole matrices, as :func:`gfe_opt.assembly.local_difference` does on a beam."""
