@@ -309,8 +309,9 @@ class Feature:
                     f"{self.value:.3f} at {ends[1]} (± {self.sigma:.3f}): a taper")
         word = ("axial stiffness " if axial else "stiffness ") + (
             "loss" if self.kind == "loss" else "rise")
-        extent = ("at one node" if self.x_from == self.x_to else
-                  f"{self.x_from:.3f} to {self.x_to:.3f} m")
+        # an axial reading is of elements, at their middles (:func:`_line_reading`)
+        extent = (("at one element" if axial else "at one node") if self.x_from == self.x_to
+                  else f"{self.x_from:.3f} to {self.x_to:.3f} m")
         if self.value <= COLLAPSED:
             return (f"the update collapses near x = {self.x:.3f} m ({extent}): k = "
                     f"{self.value:.2f} of the model's, no physical reading (the nodal family "

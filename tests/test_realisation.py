@@ -135,6 +135,9 @@ def test_profile_words_never_call_ringing_a_finding():
     assert "not a finding" in fits[1] and "not a finding" not in open_[1]
     assert "not reproduced by the fitted crack" in open_[1]
     assert "(at one node)" in fits[1] and "0.150 to 0.250 m" in fits[0]
+    # a bar's or member's axial reading is of its elements (at their middles), not nodes
+    axial = rise.describe(quantity="EA")
+    assert "axial stiffness rise" in axial and "(at one element)" in axial
 
 
 def test_one_ringing_draw_does_not_speak_for_the_reading():
