@@ -413,6 +413,10 @@ class Fit:
     #: per effect, parameters that ended on a bound of their range: {key: "at least" |
     #: "at most"} (the data tell one side only)
     bounds: tuple = ()
+    #: per effect, the keys of its variables that ended on a bound of their range, on any
+    #: scale (a zone's stiffness ratio at 0.05, a place at an end; a key once a variable):
+    #: held there, not free parameters of the fit
+    held: tuple = ()
 
     @property
     def effect(self) -> str:
@@ -430,6 +434,15 @@ class Fit:
     def bound(self) -> dict:
         """The added effect's parameters on a bound of their range (one-sided)."""
         return self.bound_of(self.added) if self.added is not None else {}
+
+    @property
+    def n_held(self) -> int:
+        """How many of the fit's variables ended on a bound of their range."""
+        return sum(len(keys) for keys in self.held)
+
+    def held_of(self, i: int) -> tuple:
+        """Effect i's keys of variables on a bound of their range (:attr:`held`)."""
+        return self.held[i] if i < len(self.held) else ()
 
     def bound_of(self, i: int) -> dict:
         """Effect i's parameters on a bound of their range."""
@@ -818,7 +831,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
                success=success and np.isfinite(fit_misfit.chi2), evaluations=residual.count,
                equivalent=[tuple(effects_of(e)) for e in equivalent],
                unidentified=unidentified, traded=traded, told=tuple(told),
-               bounds=tuple(saturated))
+               bounds=tuple(saturated), held=_held(slots, z, lower, upper))
 
 
 #: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
@@ -1279,6 +1292,20 @@ def bound_side(z: float, lower: float, upper: float) -> str | None:
     if z <= lower + span:
         return "lower"
     return None
+
+
+def _held(slots, z, lower, upper) -> tuple:
+    """Per slot, the keys of its variables that end on a bound of their range (any scale;
+    :func:`bound_side`)."""
+    out, i = [], 0
+    for slot in slots:
+        keys = []
+        for v in slot.variables:
+            if bound_side(z[i], lower[i], upper[i]) is not None:
+                keys.append(v.key)
+            i += 1
+        out.append(tuple(keys))
+    return tuple(out)
 
 
 def _saturated(slots, z, lower, upper) -> list:
