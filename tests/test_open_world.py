@@ -81,6 +81,38 @@ def test_a_quadratic_taper_with_no_noise_given_is_a_profile_not_a_long_zone():
     assert diagnosis.suggested == ["stiffness_profile"]
 
 
+@pytest.mark.xfail(strict=True, reason="known weakness (stop 77): the profile's knots are "
+                   "judged on the named candidates' noise floor; judging them on the profiles' "
+                   "own changed the real cantilever's first diagnosis (README, Validation "
+                   "campaign)")
+def test_a_quadratic_taper_read_on_its_profiles_own_floor_is_found_with_its_knots():
+    """EI falling as a quadratic to 0.73 of the model's at the pinned end of a
+    clamped–pinned beam, 3 modes at 10 sensors, the noise stated: no named effect fits
+    (a long zone to χ²/n 13), a free profile does.  Its 3 knots (χ² 35.6) beat its 2 (76.3)
+    by more than the significance asks of the noise floor the profiles themselves set (the
+    most flexible fit's χ²/dof, 1.2), though not of the floor the named effects set (14.7):
+    judged on that one, the 2 knots (χ²/n 2.3) are kept, do not explain, and the taper is
+    said unexplained (the seed-2600 beam campaign's taper-quadratic-clamped-pinned-2720).
+    The profile's ratios would follow the taper."""
+    from .truths import _node_sensors
+
+    taper = -0.266
+    beam = ReferenceBeam(elements=800, supports=("clamped", "pinned"),
+                         rigidity=lambda x: 1.0 + taper * (x / L) ** 2)
+    s = _node_sensors(L, 60, 10)
+    f, y = beam.measure(3, s, shape_noise=0.003, freq_noise=0.0005, seed=2721)
+    measured = make_measured(s, "w", f, y, "reference")
+    model = make_model(elements=60, supports={"left": "clamped", "right": "pinned"})
+    diagnosis = diagnose(model, measured, **NOISE)
+    assert diagnosis.verdict == "effect_found", diagnosis.notes
+    assert diagnosis.suggested == ["stiffness_profile"]
+    profile = diagnosis.best.parameters
+    assert len(profile["x"]) >= 3
+    x = np.asarray(profile["x"])
+    truth = 1.0 + taper * (x / L) ** 2
+    assert np.max(np.abs(np.asarray(profile["ratio"]) / truth - 1)) < 0.05
+
+
 def loop_words(model, measured):
     from gfe_opt.diagnosis import diagnose
 
