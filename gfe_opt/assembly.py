@@ -30,6 +30,25 @@ import scipy.sparse as sp
 from . import elements as el
 from .model import Model
 
+#: free DOFs up to which a beam's or bar's modes come from LAPACK on the dense matrices;
+#: above, from shift-invert Lanczos on the sparse ones, whose cost grows as the DOFs where
+#: the dense solve's grows as their cube.  A speed choice, not a result: the shapes agree
+#: to 1e-10 and move as smoothly with a parameter either way (a crack moved by 1e-11 of
+#: the length: second differences 6e-11 sparse, 5e-11 dense at 100 elements; 2e-10 and
+#: 4e-10 at 200), the frequencies are the shapes' Rayleigh quotients either way.  Measured
+#: side by side, ``python scripts/bench.py --parts dense`` (9 modes, one BLAS thread): the
+#: sparse solve is the faster from 152 free DOFs on beams (1.91 against 2.00 ms; 1.89
+#: against 1.83 at 144) and from 180 on bars (2.17 against 2.49; 2.12 against 2.05 at
+#: 160); 3.3 against 13.8 ms at a beam's 400, 4.7 against 633 ms at a bar's 1 500
+DENSE_SOLVE_DOFS = 148
+#: ... and up to which their eigen-derivatives' bordered systems are solved dense; above,
+#: by Nelson's sparse form (the same derivatives to 3e-8 of the largest, the systems'
+#: own conditioning at 400 DOFs).  The same bench: Nelson's form is the faster from 128
+#: free DOFs on beams (2.90 against 3.03 ms, 9 modes and 4 parameters; 2.83 against 2.69
+#: at 120) and from 140 on bars; 5.2 against 40.9 ms at a beam's 400.  The campaigns'
+#: beams (30 to 60 elements, at most 122 free DOFs) stay dense on both counts
+DENSE_DERIVATIVE_DOFS = 124
+
 
 @dataclass(frozen=True)
 class Discretisation:
@@ -76,6 +95,19 @@ class Discretisation:
         """The unconstrained DOFs (read-only; kept: the modal solve, the observation and the
         eigen-derivatives ask for them at every evaluation)."""
         return free_dofs(self.n_dof, np.asarray(self.constrained, dtype=np.int64).tobytes())
+
+    @property
+    def dense_solve(self) -> bool:
+        """The modal solve on the dense pencil (LAPACK) up to :data:`DENSE_SOLVE_DOFS` free
+        DOFs, shift-invert Lanczos on the sparse one above (a speed choice:
+        :mod:`gfe_opt.modal`)."""
+        return self.free.size <= DENSE_SOLVE_DOFS
+
+    @property
+    def dense_derivatives(self) -> bool:
+        """The eigen-derivatives' bordered systems dense up to :data:`DENSE_DERIVATIVE_DOFS`
+        free DOFs, Nelson's sparse form above (a speed choice: :mod:`gfe_opt.sensitivity`)."""
+        return self.free.size <= DENSE_DERIVATIVE_DOFS
 
     def element_dofs(self) -> np.ndarray:
         """(n_elements, 2 n) global DOF indices of each element."""

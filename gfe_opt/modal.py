@@ -44,7 +44,10 @@ from .inputs import MAX_ELEMENTS
 from .model import Model
 from .threads import one_blas_thread
 
-#: Up to this many free DOFs a dense generalised eigensolver is used.
+#: Up to this many free DOFs a dense generalised eigensolver is used, where the caller does
+#: not choose (a beam's or bar's discretisation does: :data:`~gfe_opt.assembly.DENSE_SOLVE_DOFS`,
+#: measured; a frame's: :data:`~gfe_opt.frame.DENSE_SOLVE_DOFS`; a condensed beam's reduced
+#: pencil takes this default)
 DENSE_LIMIT = 1500
 #: Beams with more elements are solved through condensed super-elements.
 CONDENSE_ABOVE = 200

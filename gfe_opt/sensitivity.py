@@ -34,7 +34,9 @@ import scipy.sparse.linalg as spla
 #: eigenvalues closer than this (relative) are repeated: their shapes have no derivative
 REPEATED_GAP = 1e-7
 #: up to this many free DOFs the bordered systems are solved dense (LAPACK): a sparse
-#: factorisation's set-up costs more than a dense one of a small model
+#: factorisation's set-up costs more than a dense one of a small model.  The default only:
+#: the fits pass their discretisation's own choice (a beam's or bar's
+#: :data:`~gfe_opt.assembly.DENSE_DERIVATIVE_DOFS`, measured; a frame's: sparse)
 DENSE_DOFS = 400
 
 

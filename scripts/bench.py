@@ -59,8 +59,14 @@ the regularisation holds it at its initial value).
    a reverse Cuthill-McKee order (now); and the demo's serial ``diagnose`` (46 elements,
    best of 5 alternated runs), with its verdict and the crack found either way.
 
+10. Dense or sparse (stop 77), ``--parts dense``: a beam's and a bar's modal solve (9
+    modes) and its eigen-derivatives (9 modes, 4 parameters: four elements' stiffness) by
+    LAPACK on the dense matrices and by the sparse route (shift-invert Lanczos; Nelson's
+    form), side by side at each size (best of alternated runs, one BLAS thread), and the
+    free DOFs from which the sparse route is the faster at every size measured.
+
 ``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale, fits, frames,
-shapes (the default: all but shapes).
+shapes, dense (the default: all but shapes and dense).
 """
 
 import argparse
@@ -169,6 +175,8 @@ def main():
         _frames(out)
     if "shapes" in parts:
         _shapes(out)
+    if "dense" in parts:
+        _dense_or_sparse(out)
     print(json.dumps(out, indent=1))
 
 
@@ -257,6 +265,71 @@ def _shapes(out):
         "one_solve": rows, "portal_one_solve": portal_row,
         "demo_diagnose_serial": {"lapack_alone_s": alone, "refined_s": refined,
                                  "ratio": refined / alone, "lapack_alone": a, "refined": b}}
+
+
+def _dense_or_sparse(out):
+    """Part 10 (module docstring)."""
+    import scipy.sparse as sparse
+
+    import gfe_opt.modal as modal
+    from gfe_opt.assembly import discretise
+    from gfe_opt.model import model_from_dict
+    from gfe_opt.sensitivity import eigen_derivatives
+    from gfe_opt.threads import one_thread_limits
+
+    sys.path.insert(0, str(ROOT))
+    from tests.conftest import STEEL_BAR, STEEL_BEAM
+
+    rows, first = [], {}
+    for kind, base, sizes in (("beam", STEEL_BEAM, (20, 30, 46, 60, 64, 68, 72, 76, 80, 100, 150,
+                                                     200)),
+                              ("bar", STEEL_BAR, (20, 50, 100, 120, 140, 160, 180, 200, 400, 800,
+                                                   1500))):
+        for n in sizes:
+            disc = discretise(model_from_dict({**base, "elements": n}, "bench"))
+            K, M = disc.global_matrices()
+            free = disc.free
+
+            def solve(dense, K=K, M=M, disc=disc):
+                return modal.solve_modes(K, M, 9, disc.constrained, disc.eigenvalue_scale,
+                                         dense=dense, free=disc.free)
+            repeats = 30 if free.size <= 400 else 5
+            with one_thread_limits():
+                (t_dense, t_sparse), (a, b) = _alternated(
+                    [lambda: solve(True), lambda: solve(False)], repeats)
+            lam = (2 * np.pi * a.frequencies_hz) ** 2
+            # four elements' stiffness: each one's entries of K
+            per = disc.dofs_per_node
+            dK = []
+            for e in np.linspace(1, n - 2, 4).astype(int):
+                dofs = np.arange(e * per, (e + 2) * per)
+                block = sparse.lil_matrix(K.shape)
+                block[np.ix_(dofs, dofs)] = K[np.ix_(dofs, dofs)].toarray()
+                dK.append(block.tocsr())
+            dM = [sparse.csr_matrix(K.shape)] * len(dK)
+
+            def derivatives(dense, K=K, M=M, free=free, lam=lam, a=a, dK=dK, dM=dM):
+                return eigen_derivatives(K, M, free, lam, a.shapes, dK, dM, dense=dense)
+            with one_thread_limits():
+                (d_dense, d_sparse), (da, db) = _alternated(
+                    [lambda: derivatives(True), lambda: derivatives(False)], repeats)
+            scale = np.max(np.abs(da[1]))
+            rows.append({"kind": kind, "elements": n, "free_dofs": int(free.size),
+                         "solve_dense_ms": 1e3 * t_dense, "solve_sparse_ms": 1e3 * t_sparse,
+                         "derivatives_dense_ms": 1e3 * d_dense,
+                         "derivatives_sparse_ms": 1e3 * d_sparse,
+                         "frequencies_rel_diff": float(np.max(np.abs(
+                             b.frequencies_hz / a.frequencies_hz - 1))),
+                         "shape_derivatives_rel_diff": float(
+                             np.max(np.abs(db[1] - da[1])) / scale)})
+    for kind in ("beam", "bar"):
+        mine = [r for r in rows if r["kind"] == kind]
+        for what in ("solve", "derivatives"):
+            faster = [r[f"{what}_sparse_ms"] < r[f"{what}_dense_ms"] for r in mine]
+            # the smallest size from which the sparse route is faster at every size measured
+            at = next((r["free_dofs"] for i, r in enumerate(mine) if all(faster[i:])), None)
+            first[f"{kind}_{what}"] = at
+    out["dense_or_sparse"] = {"rows": rows, "sparse_faster_from_free_dofs": first}
 
 
 def _ratio(out):
