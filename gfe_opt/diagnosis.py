@@ -872,8 +872,7 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
         # what it explains alone exceeds its threshold, whatever its size's σ (one loose
         # joint standing for two is barely determined alone): it may lead a pair when the
         # uniform change fits best alone (:func:`_lookahead`; the pair is judged itself)
-        f.gains_enough = (f.success and not f.failed and f.gain > f.threshold
-                          and not f.unidentified)
+        f.gains_enough = _gains(f) and not f.unidentified
         f.significant = f.gains_enough and f.size_sigmas >= SIZE_SIGMAS
         if f.significant and material is not None and f.name != material.name \
                 and not material.failed:
@@ -1656,8 +1655,7 @@ def _may_lead(fit, model) -> bool:
     stricter rule their campaign judged."""
     if fit.gains_enough:
         return True
-    return (model.kind == "frame" and fit.success and not fit.failed
-            and fit.gain > fit.threshold)
+    return model.kind == "frame" and _gains(fit)
 
 
 def _simplest_first(model, measured, noise, hint, explains, sel, first, pair, others, tried):
@@ -1756,8 +1754,13 @@ def _explains(fit) -> bool:
     no more than one of the two.  A free profile that is no finding is not one of them:
     named effects win where they explain (a uniform E is not said alike to the 2-knot
     profile that holds it)."""
-    return fit.significant or (fit.success and not fit.failed and fit.gain > fit.threshold
+    return fit.significant or (_gains(fit)
                                and not getattr(effect_type(fit.name), "fallback", False))
+
+
+def _gains(fit) -> bool:
+    """The fit converged and lowers χ² by more than its threshold (set by :func:`_judge`)."""
+    return fit.success and not fit.failed and fit.gain > fit.threshold
 
 
 def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[str]:

@@ -821,7 +821,8 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     effects = effects_of(z)
     fitted = base.with_effects(effects, check=False)
     fit_misfit = misfit(fitted, measured, noise, C)
-    saturated = _saturated(slots, z, lower, upper)
+    sides = _bound_sides(slots, z, lower, upper)
+    saturated = _saturated(sides)
     sigma, unidentified, traded, told = _uncertainty(residual, z, slots, base, fit_misfit,
                                                      lower, upper, saturated)
     added = [i for i, s in enumerate(slots) if s.added]
@@ -831,7 +832,7 @@ def fit_effects(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
                success=success and np.isfinite(fit_misfit.chi2), evaluations=residual.count,
                equivalent=[tuple(effects_of(e)) for e in equivalent],
                unidentified=unidentified, traded=traded, told=tuple(told),
-               bounds=tuple(saturated), held=_held(slots, z, lower, upper))
+               bounds=tuple(saturated), held=_held(sides))
 
 
 #: Δχ² (in units of the noise floor) under which two fits cannot be told apart (χ²₁, 95 %)
@@ -1294,35 +1295,30 @@ def bound_side(z: float, lower: float, upper: float) -> str | None:
     return None
 
 
-def _held(slots, z, lower, upper) -> tuple:
-    """Per slot, the keys of its variables that end on a bound of their range (any scale;
-    :func:`bound_side`)."""
+def _bound_sides(slots, z, lower, upper) -> list:
+    """Per slot, each of its variables with the bound of its range it ends on
+    (:func:`bound_side`: ``"upper"``, ``"lower"`` or None)."""
     out, i = [], 0
     for slot in slots:
-        keys = []
-        for v in slot.variables:
-            if bound_side(z[i], lower[i], upper[i]) is not None:
-                keys.append(v.key)
-            i += 1
-        out.append(tuple(keys))
-    return tuple(out)
-
-
-def _saturated(slots, z, lower, upper) -> list:
-    """Per slot, its log-scaled variables (stiffnesses over decades) that end on a bound of
-    their range: ``{key: "at least"}`` on the upper one, ``"at most"`` on the lower.  The
-    data then tell only one side (a roller read as a spring: rigid as far as the modes
-    tell); a σ from the curvature there means nothing."""
-    out, i = [], 0
-    for slot in slots:
-        marks = {}
-        for v in slot.variables:
-            side = bound_side(z[i], lower[i], upper[i]) if v.log and v.index is None else None
-            if side is not None:
-                marks[v.key] = "at least" if side == "upper" else "at most"
-            i += 1
-        out.append(marks)
+        out.append([(v, bound_side(z[i + k], lower[i + k], upper[i + k]))
+                    for k, v in enumerate(slot.variables)])
+        i += len(slot.variables)
     return out
+
+
+def _held(sides) -> tuple:
+    """Per slot (of :func:`_bound_sides`), the keys of its variables that end on a bound of
+    their range, on any scale."""
+    return tuple(tuple(v.key for v, side in slot if side is not None) for slot in sides)
+
+
+def _saturated(sides) -> list:
+    """Per slot (of :func:`_bound_sides`), its log-scaled variables (stiffnesses over
+    decades) that end on a bound of their range: ``{key: "at least"}`` on the upper one,
+    ``"at most"`` on the lower.  The data then tell only one side (a roller read as a
+    spring: rigid as far as the modes tell); a σ from the curvature there means nothing."""
+    return [{v.key: "at least" if side == "upper" else "at most" for v, side in slot
+             if side is not None and v.log and v.index is None} for slot in sides]
 
 
 def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=None):
