@@ -46,7 +46,9 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
 8. A present local effect whose re-estimate ends on a bound of its range (not its
    position) is fitted over as every other local kind in its place; one with a lower
    information criterion than the model as it stands is suggested first, with
-   ``replace`` naming the effect it takes the place of (:func:`_swap`).
+   ``replace`` naming the effect it takes the place of (:func:`_swap`).  Where none
+   ranks above it and nothing is to be added, a caveat (kind ``edge``) names the other
+   kind in its place that ranks best (:func:`_edge_caveats`).
 9. Each present effect is taken out in turn, the others re-estimated; one whose removal
    raises χ² by less than the threshold of step 3 for its parameters is ``not_needed``
    (:func:`_not_needed`): said, with its ``update --drop``; no verdict changes.
@@ -239,7 +241,9 @@ class Caveat(str):
     Kinds: ``alike`` (another effect fits as well), ``mirror`` (the finding at its mirror
     place), ``places`` (at other places of a frame), ``equivalent`` (other parameter sets),
     ``split`` (a sum told, not how it splits), ``combination`` (a combination of parameters
-    told, not each), ``undecided`` (not a finding: the alternatives are why).  ``present``:
+    told, not each), ``undecided`` (not a finding: the alternatives are why), ``edge`` (a
+    present effect on the edge of its range: the other kind in its place that ranks best,
+    :func:`_edge_caveats`).  ``present``:
     None for a caveat on the finding; for one on an effect the model holds already (its
     mirror place), that effect's index in the model's effects, and the alternatives hold
     it alone, where it would be instead."""
@@ -1206,7 +1210,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
     # selection step 10 on that finding (applied below, where no replacement stands), once
     form = _form_of_present(model, measured, noise, C, ref_misfit, finding) \
         if finding is not None and model.effects else None
-    swap = _swap(model, measured, noise, reference, names, sel)
+    swap, edged = _swap(model, measured, noise, reference, names, sel)
     if swap is not None and finding is not None and form is None \
             and sel.penalised(finding) < sel.penalised(swap[1]):
         # an addition that keeps the present effect explains more for its parameters
@@ -1271,6 +1275,10 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
         notes += _ambiguities(ranked[0], alike, measured, noise, C, sel,
                               together if suggested and together is not None else None)
     notes += _present_mirrors(reference, measured, noise, C, sel)
+    if replace is None and withheld is None and verdict != "effect_found":
+        # (with an addition to make, an effect on its edge may be there only while the
+        # addition is missing: the next diagnosis, after it, judges it)
+        notes += _edge_caveats(model, reference, edged, sel)
     # the known effects as the verdict reads them: re-estimated beside the finding when
     # one is to be added (a known zone that the reference alone moves 0.13 m to take up a
     # hidden one stays where it was beside it), else re-estimated alone
@@ -1467,16 +1475,19 @@ def _on_edge(model, effect) -> list[str]:
 
 
 def _swap(model, measured, noise, reference, names, sel):
-    """(index, fit, edges) of the other kind that, in place of a present local effect which ends on
-    the edge of its range (:func:`_on_edge`), has the lower information criterion (the
-    others re-estimated with it), or None.  An effect added early can stand in for one it
-    cannot be (a heavy zone at its largest mass ratio for a point mass, before the shear of
-    a deep beam was added): the loop otherwise never looks at it again.  :func:`diagnose`
-    keeps the replacement only when it ranks above the addition it would otherwise
-    suggest (the information criterion of :meth:`_Selection.penalised`)."""
+    """((index, fit, edges) of the other kind that, in place of a present local effect
+    which ends on the edge of its range (:func:`_on_edge`), has the lower information
+    criterion (the others re-estimated with it), or None; and for each present effect on
+    its edge (index, edges, the converged other kind in its place of the lowest criterion
+    or None), which :func:`_edge_caveats` reads where nothing replaces it).  An effect
+    added early can stand in for one it cannot be (a heavy zone at its largest mass ratio
+    for a point mass, before the shear of a deep beam was added): the loop otherwise never
+    looks at it again.  :func:`diagnose` keeps the replacement only when it ranks above
+    the addition it would otherwise suggest (the information criterion of
+    :meth:`_Selection.penalised`)."""
     if reference is None or not reference.success:
-        return None
-    best = None
+        return None, []
+    best, edged = None, []
     for i, effect in enumerate(reference.effects):
         kind = effect_type(effect.name)
         edges = _on_edge(model, effect) if kind.is_local(model) else []
@@ -1499,13 +1510,50 @@ def _swap(model, measured, noise, reference, names, sel):
                 continue
             alts.append(name)
         jobs = [("candidate", (base, measured, name, noise, hint)) for name in alts]
+        closest = None
         for alt in _run_jobs(jobs, None, alts) if jobs else []:
-            if not alt.success or alt.unidentified \
-                    or sel.penalised(alt) >= sel.penalised(reference):
+            if not alt.success or alt.unidentified:
+                continue
+            if closest is None or sel.penalised(alt) < sel.penalised(closest):
+                closest = alt
+            if sel.penalised(alt) >= sel.penalised(reference):
                 continue
             if best is None or sel.penalised(alt) < sel.penalised(best[1]):
                 best = (i, alt, edges)
-    return best
+        edged.append((i, edges, closest))
+    return best, edged
+
+
+def _edge_caveats(model, reference, edged, sel) -> list[Caveat]:
+    """A caveat (kind ``edge``) for each present effect that ends on the edge of its range
+    where no other kind in its place ranks above it (:func:`_swap`): the data ask for a
+    value the kind cannot take, so the effect stands for something it is not quite; the
+    other kind in its place of the lowest information criterion is named with its fit
+    (the held-out beam campaign's continuum-block-clamped-free-2769: a block glued on a
+    deep beam, read as a zone at its largest mass ratio beside the shear, said nothing
+    about the point mass, 0.106 kg at 0.4618 m against the block's 0.105 kg at 0.4620 m,
+    that fits nearly as well with two parameters fewer)."""
+    out = []
+    for index, edges, closest in edged:
+        present = model.effects[index]
+        now = reference.misfit.chi2_per_residual
+        text = (f"the present {present.name} (effects[{index}]) ends on the edge of its range "
+                f"({', '.join(edges)}): the data ask for a value a {present.name} cannot "
+                "take")
+        if closest is None:
+            out.append(Caveat(text + "; no other kind in its place converged", "edge", (),
+                              index))
+            continue
+        alt = next(e for e in reversed(closest.effects) if e.name == closest.name)
+        fewer = reference.n_params - closest.n_params
+        count = (f"{abs(fewer)} parameter{'s' if abs(fewer) != 1 else ''} "
+                 f"{'fewer' if fewer > 0 else 'more'}" if fewer else "as many parameters")
+        out.append(Caveat(
+            text + f"; of the other kinds in its place the closest is {closest.describe()} "
+            f"(χ²/n {closest.misfit.chi2_per_residual:.3g} against {now:.3g} now, {count}), "
+            "which does not rank above it (to try it: gfe-opt update MODEL MEASURED --drop "
+            f"{index} --add {closest.name})", "edge", [(alt,)], index))
+    return out
 
 
 def _profile_argument(profile) -> str:

@@ -411,3 +411,32 @@ def test_a_taper_left_after_two_cracks_is_offered_as_a_profile_not_named_as_a_zo
     (profile,) = [f for f in d.fits if f.name == "stiffness_profile"]
     ratio = profile.effects[-1].parameters["ratio"]
     assert abs(ratio[0] - 1.0) < 0.01 and abs(ratio[-1] - 1.05) < 0.01, ratio
+
+
+def test_a_zone_on_the_edge_of_its_range_is_said_with_the_point_mass_in_its_place():
+    """A block glued on a deep cantilever, a 2-D plane-stress continuum of real geometry
+    (the held-out seed-2600 campaign's continuum-block-clamped-free-2769).  The loop adds a
+    zone and the shear and ends ``consistent``, the zone at the largest mass ratio its
+    range allows beside the shear: a point mass in its place (the shear re-estimated with
+    it) fits nearly as well with two parameters fewer, yet ranks below it.  The last
+    diagnosis says so, a caveat of kind ``edge`` on the zone whose alternative is that
+    point mass: where the block is, and its mass."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import bench_diagnosis
+
+    from . import truths
+
+    case = truths.continuum_case(2769)
+    (hidden,) = case.hidden
+    assert hidden.klass == "mass" and hidden.law == "block-2d"
+    row = bench_diagnosis.run_case(case)
+    assert row["exit"] == 0 and row["verdicts"][-1] == "consistent", row
+    edges = [c for c in row["caveats"] if c["kind"] == "edge"]
+    assert len(edges) == 1, row["caveats"]
+    (edge,) = edges
+    zone = [e["effect"] for e in row["final_effects"]].index("section_loss")
+    assert edge["present"] == zone
+    ((alt,),) = edge["alternatives"]
+    assert alt["effect"] == "point_mass"
+    assert abs(alt["parameters"]["position"] - hidden.position) < 0.02 * L
+    assert abs(alt["parameters"]["mass"] / hidden.size["mass"] - 1) < 0.05
