@@ -122,10 +122,12 @@ def _profile_panel(ax, band, label, quantity="EI"):
     if band.explained is not None:
         ax.plot(x, band.explained, "--", color="tab:red",
                 label=f"the same, of the fitted {label}'s modes")
-    for f in band.features:
+    for f in (*band.features, *band.further):
         if f.kind not in ("loss", "rise"):
             continue
-        grey = f in band.unexplained and band.explained is not None
+        # grey: not reproduced by the effect found, or beyond the band but not weighed
+        # (the further features, :attr:`~gfe_opt.realisation.ProfileBand.further`)
+        grey = f in band.further or (f in band.unexplained and band.explained is not None)
         text = "collapsed" if f.value <= COLLAPSED else f"{f.value:.2f}±{f.sigma:.2g}"
         # at the curve: a local value is read against the profile's level (its trend)
         at = f.value * float(np.interp(f.x, band.x, band.trend))

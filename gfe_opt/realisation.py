@@ -343,6 +343,10 @@ class ProfileBand:
     #: what was read: "EI" (a beam's bending, at its nodes) or "EA" (a bar's axial, at its
     #: elements' middles)
     quantity: str = "EI"
+    #: the features beyond the band less significant than the three of ``features``: said
+    #: and drawn (the figure shows every node beyond the band; the words named only the
+    #: three), not weighed by the diagnosis, which reads ``features``
+    further: tuple = ()
 
 
 def _generic_ratio_of(disc, data, noise):
@@ -447,8 +451,9 @@ def profile_band(disc: Discretisation, measured, result, noise, samples: int = B
     x, ratio, quantity = _line_reading(disc, result)
     ratio = ratio / null
     sigma = np.where(_determined(disc, own), sigma, np.inf)
-    trend, features = _features(x, ratio, sigma, measured.n_modes)
-    return ProfileBand(x, ratio, sigma, trend, tuple(features), null, quantity=quantity)
+    trend, features, further = _features(x, ratio, sigma, measured.n_modes)
+    return ProfileBand(x, ratio, sigma, trend, tuple(features), null, quantity=quantity,
+                       further=tuple(further))
 
 
 @dataclass(frozen=True)
@@ -467,6 +472,20 @@ class FrameProfileBand:
                  for m, start, b, what in self.members for f in b.features]
         found.sort(key=lambda item: -item[0])
         return tuple(item[1:] for item in found[:FRAME_FEATURES])
+
+    @property
+    def further(self) -> tuple:
+        """(member, its start node, feature, quantity) of the features beyond the band
+        that :attr:`features` leaves out (beyond :data:`FRAME_FEATURES`, or beyond a
+        member's three), the most significant first: said and drawn, not weighed."""
+        found = [(f.significance, m, start, f, what)
+                 for m, start, b, what in self.members for f in b.features]
+        found.sort(key=lambda item: -item[0])
+        rest = found[FRAME_FEATURES:] + [(f.significance, m, start, f, what)
+                                         for m, start, b, what in self.members
+                                         for f in b.further]
+        rest.sort(key=lambda item: -item[0])
+        return tuple(item[1:] for item in rest)
 
     @property
     def unexplained(self) -> tuple:
@@ -522,10 +541,12 @@ def _frame_band(disc, result, null, sigma, n_modes) -> FrameProfileBand:
             part = slice(i, i + x.size)
             i += x.size
             r = ratio / null[part]
-            trend, features = _features(x, r, sigma[part], n_modes)
+            trend, features, further = _features(x, r, sigma[part], n_modes)
             features = [f for f in features if _frame_change(f) >= FEATURE_CHANGE]
+            further = [f for f in further if _frame_change(f) >= FEATURE_CHANGE]
             out.append((member, m.start, ProfileBand(x, r, sigma[part], trend,
-                                                     tuple(features), null[part]), what))
+                                                     tuple(features), null[part],
+                                                     further=tuple(further)), what))
     return FrameProfileBand(tuple(out), tuple(model.members))
 
 
@@ -644,8 +665,9 @@ def _features(x, ratio, sigma, n_modes):
     """A weighted straight line through the profile (its uncertainty inflated by the
     scatter about it), then the runs of nodes more than FEATURE_SIGMAS below (losses) or
     above (rises) it; a run of the other sign next to a larger one (closer than the
-    resolution of n modes, length / n) is its side lobe and left out; at most 3, the
-    most significant first."""
+    resolution of n modes, length / n) is its side lobe and left out.  Returns the trend,
+    the (at most) 3 most significant features, most significant first, which the diagnosis
+    weighs, and the further ones beyond the band, which are said and drawn."""
     length = x[-1] - x[0]
     t = (x - x[0]) / length - 0.5
     use = np.isfinite(sigma) & (sigma < 10)
@@ -703,7 +725,8 @@ def _features(x, ratio, sigma, n_modes):
                                             float(ratio[k] / trend[k]),
                                             float(sigma[k] / trend[k]))))
     features.sort(key=lambda item: -item[0])
-    return trend, [replace(f, significance=float(score)) for score, f in features[:3]]
+    features = [replace(f, significance=float(score)) for score, f in features]
+    return trend, features[:3], features[3:]
 
 
 def describe_profile(band: ProfileBand, effect: str | None = None,
@@ -728,19 +751,27 @@ def describe_profile(band: ProfileBand, effect: str | None = None,
             return float(np.interp(f.x, b.x, b.trend)) if f.kind in ("loss", "rise") \
                 and f.value > COLLAPSED else 1.0
 
-        features = [((m, f, what), f"{m} (x from {start}): "
-                     f"{f.describe(tuple(f'node {n}' for n in ends[m]), what, level(m, f, what))}")
+        def said(m, start, f, what):
+            return (f"{m} (x from {start}): "
+                    f"{f.describe(tuple(f'node {n}' for n in ends[m]), what, level(m, f, what))}")
+        features = [((m, f, what), said(m, start, f, what))
                     for m, start, f, what in band.features]
+        further = [said(*item) for item in band.further]
         unexplained = [(m, f, what) for m, _, f, what in band.unexplained]
         explained = band.members[0][2].explained is not None
     else:
         features = [(f, f.describe(quantity=band.quantity)) for f in band.features]
+        further = [f.describe(quantity=band.quantity) for f in band.further]
         unexplained, explained = band.unexplained, band.explained is not None
+    # the further features beyond the band, which the figure shows too, in one sentence:
+    # named, not weighed (the diagnosis reads the three above)
+    rest = ["beyond the band too, less significant than those (not weighed): "
+            + "; ".join(further)] if further else []
     if effect is None or not explained:
-        return [text for _, text in features]
+        return [text for _, text in features] + rest
     lobe = (f" (not reproduced by the fitted {effect}; with the {effect} the test fits to "
             "the noise, so this is the update's ringing, not a finding)" if explains_test
             else f" (not reproduced by the fitted {effect})")
     return [text + (lobe if f in unexplained else
                     f" (the fitted {effect}'s own modes show it too)")
-            for f, text in features]
+            for f, text in features] + rest

@@ -140,6 +140,39 @@ def test_profile_words_never_call_ringing_a_finding():
     assert "axial stiffness rise" in axial and "(at one element)" in axial
 
 
+def test_every_feature_beyond_the_band_is_said_the_three_most_significant_weighed():
+    """Five separate losses beyond the band (the figure draws every node): the three most
+    significant are the band's features, which the diagnosis weighs; the other two are
+    said too, the more significant first, in one sentence that says they are not weighed,
+    and the figure labels all five."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from gfe_opt.plots import profile_with_band
+    from gfe_opt.realisation import ProfileBand, _features, describe_profile
+
+    x = np.linspace(0.0, 1.0, 101)
+    ratio = np.ones_like(x)
+    depths = {0.1: 0.80, 0.3: 0.70, 0.5: 0.85, 0.7: 0.60, 0.9: 0.75}
+    for where, value in depths.items():
+        ratio[np.argmin(np.abs(x - where))] = value
+    sigma = np.full_like(x, 0.01)
+    trend, features, further = _features(x, ratio, sigma, 10)
+    assert [round(f.x, 2) for f in features] == [0.7, 0.3, 0.9]
+    assert [round(f.x, 2) for f in further] == [0.1, 0.5]
+    assert all(a.significance >= b.significance for a, b in zip(features + further,
+                                                                (features + further)[1:]))
+    band = ProfileBand(x, ratio, sigma, trend, tuple(features), np.ones_like(x),
+                       further=tuple(further))
+    words = describe_profile(band)
+    assert len(words) == 4 and "not weighed" in words[3]
+    assert words[3].index("x = 0.100 m") < words[3].index("x = 0.500 m")
+    assert not any("not weighed" in w for w in words[:3])
+    fig = profile_with_band(band)
+    labels = [t.get_text() for t in fig.axes[0].texts]
+    assert sorted(labels) == sorted(f"{v:.2f}±0.01" for v in depths.values())
+
+
 def test_one_ringing_draw_does_not_speak_for_the_reading():
     """What the fitted model's update typically shows is the median of its draws: one draw
     that rings by ±50 % (seen among six on a rising taper) leaves it where the others
