@@ -580,6 +580,12 @@ def _matched_fits(rows_a, rows_b):
 
 
 def _fits(out):
+    with tempfile.TemporaryDirectory(prefix="gfe-bench-fits-") as tmp:   # (removed after)
+        _fits_sides(out, Path(tmp))
+
+
+def _fits_sides(out, work: Path):
+    """Part 7's sides, each in a fresh process, in the folder ``work``."""
     from gfe_opt.measured import save_measured
     from gfe_opt.model import Effect, load_model, save_model
     from gfe_opt.problems import problem_file
@@ -588,7 +594,6 @@ def _fits(out):
     sys.path.insert(0, str(ROOT))
     from tests.truths import write_campaign
 
-    work = Path(tempfile.mkdtemp(prefix="gfe-bench-fits-"))
     model = load_model(problem_file("ss-steel-beam.toml"))
     write_campaign(model, work / "sets", 10, seed=3)
     save_model(model.with_effects([]), work / "mass-model.toml")
