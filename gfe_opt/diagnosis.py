@@ -1079,22 +1079,10 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
             # best alone is no reason to withhold the named effect (a notch and shear in a
             # continuum).  A pair that merely ties with a profile far from the noise is
             # one more way to absorb model error, not the structure's difference
-            # a pair the data do not determine (another end fits as well, not its mirror:
-            # :func:`_undetermined`) is no rival of the profile nor a finding to set
-            # against it: the profile is then judged against the best alone (a quadratic
-            # taper read as a crack with a long zone, two such ends alike, was said a crack
-            # alone where the profile fitted 20 times better: the held-out seed-2600
-            # campaign's taper-quadratic-clamped-pinned-2719)
-            contender = profile is not None and profile.significant
-            rivalled = profile is not None and any(
-                sel.better(p, profile) for p in tried
-                if not (contender and _undetermined(p, model)))
+            rivalled = profile is not None and any(sel.better(p, profile) for p in tried)
             if pair is not None and profile is not None and profile.success \
                     and not profile.failed and sel.better(profile, pair):
                 pair = None   # a free profile explains significantly more than the pair
-            undecided_pair = None
-            if pair is not None and contender and _undetermined(pair, model):
-                undecided_pair, pair = pair, None
             if pair is not None:
                 notes.append(Recommendation(
                     f"{first.name} with a further {pair.name} brings the misfit to the "
@@ -1113,9 +1101,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
                                             (profile.name,)))
                 best.significant = False
             elif profile is not None and profile.significant and sel.better(profile, best) \
-                    and not rivalled and (tied := _tied_pair(
-                        [p for p in tried if not _undetermined(p, model)], profile,
-                        sel)) is not None:
+                    and not rivalled and (tied := _tied_pair(tried, profile, sel)) is not None:
                 # the free profile explains significantly more than every named effect
                 # alone but not more than a determined pair: the pair is the finding, with
                 # what remains after it (a notch in a continuum read with the E that the
@@ -1138,14 +1124,8 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
                     f.significant = False
             elif rivalled:
                 profile.significant = False  # a pair of named effects does as well
-            elif undecided_pair is not None:
-                profile.significant = False  # the profile does not beat the best alone
             # else: the best named effect is the finding, and what remains after it is said
             # (``remaining``): the next diagnosis works on it
-            if undecided_pair is not None:
-                notes.append(_undecided_note(undecided_pair,
-                                             _undetermined(undecided_pair, model), measured,
-                                             len(model.effects), "the pair is not suggested"))
         elif explained and profile is not None:
             profile.significant = False  # named effects win where they explain
         if profile is not None and profile.significant and not explains(profile):

@@ -93,7 +93,9 @@ def frame_profiles(band, label=None):
     for row, (member, start, b, _) in zip(axes, bending):
         a, e = ends.get(member, (start, "?"))
         for ax, what, part in ((row[0], "EI", b), (row[1], "EA", axial[member][2])):
-            _profile_panel(ax, part, label, quantity=what)
+            # the frame's weighed features (at most three in all) in black, as the words
+            weighed = [f for m, _, f, q in band.features if m == member and q == what]
+            _profile_panel(ax, part, label, quantity=what, weighed=weighed)
             ax.set_title(f"{member}: {what}, from node {a} to node {e}", fontsize=9)
             ax.set_xlabel(f"distance from node {a} [m]", fontsize=8)
     _legend_below(fig, axes[0][0])
@@ -109,9 +111,10 @@ def _legend_below(fig, ax):
                fontsize=7, frameon=False)
 
 
-def _profile_panel(ax, band, label, quantity="EI"):
+def _profile_panel(ax, band, label, quantity="EI", weighed=None):
     """k_i / k_i0 (``quantity`` "EA": EA_i / EA_i0) of one
-    :class:`~gfe_opt.realisation.ProfileBand` on ``ax``."""
+    :class:`~gfe_opt.realisation.ProfileBand` on ``ax``; ``weighed``: the features of it
+    the diagnosis weighs, where not all of ``band.features`` (a frame member's)"""
     from .realisation import COLLAPSED
 
     x = band.x
@@ -127,7 +130,8 @@ def _profile_panel(ax, band, label, quantity="EI"):
             continue
         # grey: not reproduced by the effect found, or beyond the band but not weighed
         # (the further features, :attr:`~gfe_opt.realisation.ProfileBand.further`)
-        grey = f in band.further or (f in band.unexplained and band.explained is not None)
+        grey = (f in band.further or (weighed is not None and f not in weighed)
+                or (f in band.unexplained and band.explained is not None))
         text = "collapsed" if f.value <= COLLAPSED else f"{f.value:.2f}±{f.sigma:.2g}"
         # at the curve: a local value is read against the profile's level (its trend)
         at = f.value * float(np.interp(f.x, band.x, band.trend))

@@ -729,6 +729,26 @@ def _features(x, ratio, sigma, n_modes):
     return trend, features[:3], features[3:]
 
 
+#: the further features (beyond the three weighed) named one by one in the words; the
+#: others are counted (a frame's 13 made one sentence of 2 000 characters)
+FURTHER_SAID = 6
+
+
+def _brief(f: Feature, quantity: str, where: str = "") -> str:
+    """A further feature in a few words (``where``: its member), its value as the figure
+    labels it."""
+    axial = "axial " if quantity == "EA" else ""
+    if f.kind == "taper":
+        return f"{where}a taper of {quantity} ({f.start:.2f} to {f.value:.2f})"
+    if f.kind == "uniform":
+        return f"{where}{quantity} uniformly {f.value:.3f}"
+    if f.value <= COLLAPSED:
+        return f"{where}a collapse at x = {f.x:.3f} m"
+    return (f"{where}an {axial}{'loss' if f.kind == 'loss' else 'rise'}"
+            if axial else f"{where}a {'loss' if f.kind == 'loss' else 'rise'}") + \
+        f" at x = {f.x:.3f} m ({f.value:.2f})"
+
+
 def describe_profile(band: ProfileBand, effect: str | None = None,
                      explains_test: bool = False) -> list[str]:
     """The generic update in words: every significant feature one sentence; with
@@ -751,22 +771,23 @@ def describe_profile(band: ProfileBand, effect: str | None = None,
             return float(np.interp(f.x, b.x, b.trend)) if f.kind in ("loss", "rise") \
                 and f.value > COLLAPSED else 1.0
 
-        def said(m, start, f, what):
-            return (f"{m} (x from {start}): "
-                    f"{f.describe(tuple(f'node {n}' for n in ends[m]), what, level(m, f, what))}")
-        features = [((m, f, what), said(m, start, f, what))
+        features = [((m, f, what), f"{m} (x from {start}): "
+                     f"{f.describe(tuple(f'node {n}' for n in ends[m]), what, level(m, f, what))}")
                     for m, start, f, what in band.features]
-        further = [said(*item) for item in band.further]
+        further = [_brief(f, what, f"{m}: ") for m, _, f, what in band.further]
         unexplained = [(m, f, what) for m, _, f, what in band.unexplained]
         explained = band.members[0][2].explained is not None
     else:
         features = [(f, f.describe(quantity=band.quantity)) for f in band.features]
-        further = [f.describe(quantity=band.quantity) for f in band.further]
+        further = [_brief(f, band.quantity) for f in band.further]
         unexplained, explained = band.unexplained, band.explained is not None
     # the further features beyond the band, which the figure shows too, in one sentence:
     # named, not weighed (the diagnosis reads the three above)
-    rest = ["beyond the band too, less significant than those (not weighed): "
-            + "; ".join(further)] if further else []
+    shown = further[:FURTHER_SAID]
+    more = len(further) - len(shown)
+    rest = ["beyond the band too, less significant than those (not weighed; the figure "
+            "labels them in grey): " + ", ".join(shown)
+            + (f" and {more} more" if more else "")] if further else []
     if effect is None or not explained:
         return [text for _, text in features] + rest
     lobe = (f" (not reproduced by the fitted {effect}; with the {effect} the test fits to "

@@ -113,16 +113,22 @@ def test_a_quadratic_taper_read_on_its_profiles_own_floor_is_found_with_its_knot
     assert np.max(np.abs(np.asarray(profile["ratio"]) / truth - 1)) < 0.05
 
 
+@pytest.mark.xfail(strict=True, reason="known weakness (stop 78): an undetermined pair "
+                   "sets the profile aside; setting such pairs aside fixed this taper but "
+                   "changed the real cantilever's first diagnosis to material with a 15 N "
+                   "compression (README, Validation campaign)")
 def test_a_taper_whose_profile_only_an_undetermined_pair_rivals_is_no_crack():
     """EI falling as a quadratic to 0.68 of the model's at the pinned end of a clamped–pinned
     beam (the held-out seed-2600 campaign's taper-quadratic-clamped-pinned-2719, drawn by
     tests/truths.py's own reference beam).  A crack alone fits 21 times worse than a free
     linear profile; a crack with a long zone fits a little better than the profile, but
-    two such pairs far apart fit as well: the data do not determine it.  Such a pair is no
-    rival of the profile: the diagnosis names nothing (``unexplained``), says the crack
-    explains a part, and offers the profile, falling towards the pinned end.  Before, the
-    undetermined pair set the profile aside and the crack alone was said missing, then
-    added: a false finding."""
+    two such pairs 0.04 m apart fit as well: the data do not determine it.  That pair
+    rivals the profile all the same, the profile is set aside, and the crack alone is said
+    missing (then added: the campaign's one false alarm on that seed).  Were such a pair no
+    rival, the diagnosis would name nothing (``unexplained``), say the crack explains a
+    part, and offer the profile, falling towards the pinned end; but on the real
+    cantilever (tests/test_real_data.py) the same rule turns material alone, with a zone
+    the frequencies do not place, into material with a further axial load of -15 ± 4 N."""
     from gfe_opt.model import model_from_dict
 
     from . import truths

@@ -166,8 +166,13 @@ def test_every_feature_beyond_the_band_is_said_the_three_most_significant_weighe
                        further=tuple(further))
     words = describe_profile(band)
     assert len(words) == 4 and "not weighed" in words[3]
-    assert words[3].index("x = 0.100 m") < words[3].index("x = 0.500 m")
+    assert "a loss at x = 0.100 m (0.80), a loss at x = 0.500 m (0.85)" in words[3]
     assert not any("not weighed" in w for w in words[:3])
+    # many further features: the first few named, the others counted
+    many = ProfileBand(x, ratio, sigma, trend, tuple(features), np.ones_like(x),
+                       further=tuple(further) * 4)
+    last = describe_profile(many)[-1]
+    assert last.count("a loss at") == 6 and last.endswith(" and 2 more")
     fig = profile_with_band(band)
     labels = [t.get_text() for t in fig.axes[0].texts]
     assert sorted(labels) == sorted(f"{v:.2f}±0.01" for v in depths.values())
