@@ -1278,7 +1278,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
     if replace is None and withheld is None and verdict != "effect_found":
         # (with an addition to make, an effect on its edge may be there only while the
         # addition is missing: the next diagnosis, after it, judges it)
-        notes += _edge_caveats(model, reference, edged, sel)
+        notes += _edge_caveats(model, reference, edged)
     # the known effects as the verdict reads them: re-estimated beside the finding when
     # one is to be added (a known zone that the reference alone moves 0.13 m to take up a
     # hidden one stays where it was beside it), else re-estimated alone
@@ -1524,7 +1524,7 @@ def _swap(model, measured, noise, reference, names, sel):
     return best, edged
 
 
-def _edge_caveats(model, reference, edged, sel) -> list[Caveat]:
+def _edge_caveats(model, reference, edged) -> list[Caveat]:
     """A caveat (kind ``edge``) for each present effect that ends on the edge of its range
     where no other kind in its place ranks above it (:func:`_swap`): the data ask for a
     value the kind cannot take, so the effect stands for something it is not quite; the
@@ -1533,10 +1533,9 @@ def _edge_caveats(model, reference, edged, sel) -> list[Caveat]:
     deep beam, read as a zone at its largest mass ratio beside the shear, said nothing
     about the point mass, 0.106 kg at 0.4618 m against the block's 0.105 kg at 0.4620 m,
     that fits nearly as well with two parameters fewer)."""
-    out = []
+    out, now = [], reference.misfit.chi2_per_residual
     for index, edges, closest in edged:
         present = model.effects[index]
-        now = reference.misfit.chi2_per_residual
         text = (f"the present {present.name} (effects[{index}]) ends on the edge of its range "
                 f"({', '.join(edges)}): the data ask for a value a {present.name} cannot "
                 "take")

@@ -324,6 +324,18 @@ class Feature:
         return (f"a local {word} near x = {self.x:.3f} m ({extent}): "
                 f"k = {self.value:.2f} ± {self.sigma:.2g} of the model's")
 
+    def brief(self, quantity="EI") -> str:
+        """In a few words, its value as the figure labels it (a further feature:
+        :func:`describe_profile`)."""
+        if self.kind == "taper":
+            return f"a taper of {quantity} ({self.start:.2f} to {self.value:.2f})"
+        if self.kind == "uniform":
+            return f"{quantity} uniformly {self.value:.3f}"
+        if self.value <= COLLAPSED:
+            return f"a collapse at x = {self.x:.3f} m"
+        what = ("an axial " if quantity == "EA" else "a ") + self.kind
+        return f"{what} at x = {self.x:.3f} m ({self.value:.2f})"
+
 
 @dataclass(frozen=True)
 class ProfileBand:
@@ -464,28 +476,26 @@ class FrameProfileBand:
     members: tuple      # (member id, its start node, ProfileBand, "EI" or "EA")
     model_members: tuple = ()   # the frame's Members (their end nodes name a taper's ends)
 
+    def _ranked(self, which: str) -> list:
+        """(member, its start node, feature, quantity) of the members' ``which`` features
+        (``"features"`` or ``"further"``), the most significant first."""
+        found = [(m, start, f, what) for m, start, b, what in self.members
+                 for f in getattr(b, which)]
+        return sorted(found, key=lambda item: -item[2].significance)
+
     @property
     def features(self) -> tuple:
         """(member, its start node, feature, quantity), the most significant first (at
         most :data:`FRAME_FEATURES`)."""
-        found = [(f.significance, m, start, f, what)
-                 for m, start, b, what in self.members for f in b.features]
-        found.sort(key=lambda item: -item[0])
-        return tuple(item[1:] for item in found[:FRAME_FEATURES])
+        return tuple(self._ranked("features")[:FRAME_FEATURES])
 
     @property
     def further(self) -> tuple:
         """(member, its start node, feature, quantity) of the features beyond the band
         that :attr:`features` leaves out (beyond :data:`FRAME_FEATURES`, or beyond a
         member's three), the most significant first: said and drawn, not weighed."""
-        found = [(f.significance, m, start, f, what)
-                 for m, start, b, what in self.members for f in b.features]
-        found.sort(key=lambda item: -item[0])
-        rest = found[FRAME_FEATURES:] + [(f.significance, m, start, f, what)
-                                         for m, start, b, what in self.members
-                                         for f in b.further]
-        rest.sort(key=lambda item: -item[0])
-        return tuple(item[1:] for item in rest)
+        rest = self._ranked("features")[FRAME_FEATURES:] + self._ranked("further")
+        return tuple(sorted(rest, key=lambda item: -item[2].significance))
 
     @property
     def unexplained(self) -> tuple:
@@ -734,21 +744,6 @@ def _features(x, ratio, sigma, n_modes):
 FURTHER_SAID = 6
 
 
-def _brief(f: Feature, quantity: str, where: str = "") -> str:
-    """A further feature in a few words (``where``: its member), its value as the figure
-    labels it."""
-    axial = "axial " if quantity == "EA" else ""
-    if f.kind == "taper":
-        return f"{where}a taper of {quantity} ({f.start:.2f} to {f.value:.2f})"
-    if f.kind == "uniform":
-        return f"{where}{quantity} uniformly {f.value:.3f}"
-    if f.value <= COLLAPSED:
-        return f"{where}a collapse at x = {f.x:.3f} m"
-    return (f"{where}an {axial}{'loss' if f.kind == 'loss' else 'rise'}"
-            if axial else f"{where}a {'loss' if f.kind == 'loss' else 'rise'}") + \
-        f" at x = {f.x:.3f} m ({f.value:.2f})"
-
-
 def describe_profile(band: ProfileBand, effect: str | None = None,
                      explains_test: bool = False) -> list[str]:
     """The generic update in words: every significant feature one sentence; with
@@ -774,12 +769,12 @@ def describe_profile(band: ProfileBand, effect: str | None = None,
         features = [((m, f, what), f"{m} (x from {start}): "
                      f"{f.describe(tuple(f'node {n}' for n in ends[m]), what, level(m, f, what))}")
                     for m, start, f, what in band.features]
-        further = [_brief(f, what, f"{m}: ") for m, _, f, what in band.further]
+        further = [f"{m}: {f.brief(what)}" for m, _, f, what in band.further]
         unexplained = [(m, f, what) for m, _, f, what in band.unexplained]
         explained = band.members[0][2].explained is not None
     else:
         features = [(f, f.describe(quantity=band.quantity)) for f in band.features]
-        further = [_brief(f, band.quantity) for f in band.further]
+        further = [f.brief(band.quantity) for f in band.further]
         unexplained, explained = band.unexplained, band.explained is not None
     # the further features beyond the band, which the figure shows too, in one sentence:
     # named, not weighed (the diagnosis reads the three above)
