@@ -1533,9 +1533,9 @@ def _edge_caveats(model, reference, edged) -> list[Caveat]:
     deep beam, read as a zone at its largest mass ratio beside the shear, said nothing
     about the point mass, 0.106 kg at 0.4618 m against the block's 0.105 kg at 0.4620 m,
     that fits nearly as well with two parameters fewer)."""
-    out, now = [], reference.misfit.chi2_per_residual
-    for index, edges, closest in edged:
-        present = model.effects[index]
+    out = []
+    for index, edges, closest in edged:   # (none without a reference: nothing present)
+        present, now = model.effects[index], reference.misfit.chi2_per_residual
         text = (f"the present {present.name} (effects[{index}]) ends on the edge of its range "
                 f"({', '.join(edges)}): the data ask for a value a {present.name} cannot "
                 "take")
