@@ -623,8 +623,15 @@ def _energy_balance(pb: _Problem):
 DIRECT_STATUS = "Solved_Direct_KKT"
 #: a step whose direct point broke element conditions: rounds of the reduced problem
 #: (:func:`_solve_reduced`), each freeing the parameters of the elements still broken,
-#: before the whole step is left to IPOPT
-REDUCED_ROUNDS = 4
+#: before the whole step is left to IPOPT.  Eight since the cone programs (stop 79): a round
+#: costs milliseconds, and of the 18 reduced steps of the semi-rigid portal's 12 draws
+#: (``gfe-opt diagnose``'s realisation) 4 needed a fifth round, the four-round limit sent
+#: them whole to IPOPT (1-4 s each), and none needed more than five
+REDUCED_ROUNDS = 8
+#: the reduced problem's solver: "clarabel" (its cone program, :func:`_conic_reduced`;
+#: IPOPT where Clarabel does not solve it) or "ipopt" (:func:`_ipopt_reduced`, as before
+#: stop 79; ``scripts/bench.py --parts reduced`` runs both side by side)
+REDUCED_SOLVER = "clarabel"
 #: at most this many parameters in the reduced problem (a dense one)
 REDUCED_SIZE = 200
 #: the reduced problem holds its conditions this far above the margin (scaled by k0, k0²):
@@ -752,12 +759,14 @@ def _solve_reduced(pb: _Problem, kkt: _Kkt, x, max_iter: int):
     affine in v and the objective above its direct minimum is ½ (v - v_u)ᵀ H (v - v_u),
     H = [S⁻¹]_SS of the bordered system's Schur complement S (the energy balance eliminated):
     the step is exactly the small problem min ½ (v - v_u)ᵀ H (v - v_u) under the element
-    conditions at z(v), as long as every condition that binds reads S alone.  IPOPT solves
-    it with every condition of the elements that read S (:func:`_constraints`' own
-    formulas); elements still broken at the point found, and elements whose condition binds
-    but which read a parameter outside S (its multiplier pushes on that one too), free
-    their parameters, for up to :data:`REDUCED_ROUNDS` rounds.  The point is then solved by
-    the bordered system itself.  Uniform mass parameters are left to the whole step."""
+    conditions at z(v), as long as every condition that binds reads S alone.  Clarabel solves
+    it as a cone program (:func:`_conic_reduced`; IPOPT, :func:`_ipopt_reduced`, where it
+    does not or :data:`REDUCED_SOLVER` says so) with every condition of the elements that
+    read S (:func:`_condition_values`' formulas); elements still broken at the point found,
+    and elements whose condition binds but which read a parameter outside S (its multiplier
+    pushes on that one too), free their parameters, for up to :data:`REDUCED_ROUNDS`
+    rounds.  The point is then solved by the bordered system itself.  Uniform mass
+    parameters are left to the whole step."""
     if pb.mmap is not None:
         return None
     P = _condition_rows(pb)
@@ -765,7 +774,7 @@ def _solve_reduced(pb: _Problem, kkt: _Kkt, x, max_iter: int):
     blocks = P.shape[0] // n
     z_u = x / pb.x_scale
     free, columns = np.zeros(0, dtype=int), {}
-    x_new, n_e, stats = x, kkt.border.shape[1], None
+    x_new, n_e, stats, used = x, kkt.border.shape[1], None, []
     binding = np.zeros(0, dtype=int)   # elements whose condition binds in the small problem
     for _ in range(REDUCED_ROUNDS):
         g, lower = _constraints(pb, x_new)
@@ -796,44 +805,23 @@ def _solve_reduced(pb: _Problem, kkt: _Kkt, x, max_iter: int):
         touched = np.unique(np.flatnonzero(np.diff(P[:, free].tocsr().indptr)) % n)
         rows = (np.arange(blocks)[:, None] * n + touched[None, :]).ravel()
         p_u, D = P[rows] @ z_u, P[rows] @ G
-        # whitened, v - v_u = T w with Tᵀ H T = I: the objective ½ wᵀw, so that IPOPT's
+        # whitened, v - v_u = T w with Tᵀ H T = I: the objective ½ wᵀw, so that a solver's
         # stopping rule measures the objective, whatever the spread of H's eigenvalues
         h, V = np.linalg.eigh(H)
         if not h[0] > 0.0:
             return None
         T = V / np.sqrt(h)
-        w = ca.SX.sym("w", free.size)
-        values = _condition_values(ca.DM(p_u) + ca.mtimes(ca.DM(D @ T), w), touched.size,
-                                   kind)
-        problem = {"x": w, "f": 0.5 * ca.sumsqr(w), "g": ca.vertcat(*values)}
-        # IPOPT twice: from the direct point, then from its point with the objective scaled
-        # to one there (its stopping rule is absolute, and a step that a few elements cross
-        # may cost 1e-5 of the objective: measured, the first solve's objective 1e-5 above
-        # a conic solver's, the second's within 1e-8, in 10-15 more iterations)
-        sol, info, scaling, iterations = None, None, 1.0, 0
-        for _ in range(2):
-            solver = ca.nlpsol("reduced_step", "ipopt", problem, {
-                "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
-                "ipopt.mu_strategy": "adaptive", "ipopt.max_iter": max_iter,
-                "ipopt.tol": 1e-10, "ipopt.acceptable_tol": 1e-8,
-                "ipopt.obj_scaling_factor": scaling,
-                # the conditions as stated (IPOPT relaxes them by 1e-8): the step's point
-                # satisfies them strictly, as a direct one does
-                "ipopt.bound_relax_factor": 0.0})
-            try:
-                out = solver(x0=np.zeros(free.size) if sol is None else sol["x"],
-                             lbg=pb.margin + REDUCED_LIFT, ubg=np.inf)
-            except RuntimeError:
+        A_w = D @ T
+        sol, info = (_conic_reduced(p_u, A_w, touched.size, kind, pb.margin)
+                     if REDUCED_SOLVER == "clarabel" else (None, None))
+        if sol is None:   # IPOPT when the cone program is not solved (or on request)
+            sol, info = _ipopt_reduced(p_u, A_w, touched.size, kind, pb.margin, max_iter)
+            if sol is None:
                 return None
-            if not solver.stats().get("success"):
-                if sol is None:
-                    return None
-                break    # (the first solve's point stands)
-            sol, info = out, solver.stats()
-            iterations += int(info.get("iter_count", 0))
-            scaling = 1.0 / max(float(sol["f"]), 1e-300)
+        used.append(info["solver"])
         stats = {"return_status": str(info.get("return_status")),
-                 "iter_count": iterations, "reduced_parameters": int(free.size)}
+                 "iter_count": int(info.get("iter_count", 0)),
+                 "reduced_parameters": int(free.size), "reduced_solvers": used}
         # the point of those parameters by the bordered solve itself (refined), not by the
         # affine map: the map carries the Schur complement's rounding into the energy
         # balance (measured 2e-9 on a 40-element bar, against 1e-16)
@@ -847,6 +835,97 @@ def _solve_reduced(pb: _Problem, kkt: _Kkt, x, max_iter: int):
         slack = np.array(sol["g"]).ravel() - pb.margin
         binding = touched[np.unique(np.flatnonzero(slack < REDUCED_BINDING) % touched.size)]
     return None
+
+
+def _conic_reduced(p, A, n: int, kind: str, margin: float):
+    """The reduced problem of :func:`_solve_reduced` as the cone program it is: min ½ wᵀw
+    with every condition of :func:`_condition_values` at p + A w at least margin +
+    :data:`REDUCED_LIFT`, each element's k_ww k_θθ - k_wθ² ≥ m (with k_ww, k_θθ ≥ m) the
+    second-order cone ‖(2 k_wθ, 2√m, k_ww - k_θθ)‖ ≤ k_ww + k_θθ.  Clarabel solves it.  Its
+    point meets the cones to its feasibility tolerance only (measured up to 2.8e-9 below
+    the bound on the semi-rigid portal's draws): a point more than half the lift short of
+    it is solved once more with the bound raised by twice the shortfall, and refused if
+    still short (the lift is there for the bordered solve's rounding, 1e-11).  Returns
+    ({"x", "g"}, info) or (None, None)."""
+    import clarabel
+
+    m, blocks = A.shape[1], A.shape[0] // n
+    ww, wt, tt = (slice(k * n, (k + 1) * n) for k in range(3))
+    linear = [slice(0, n)] if kind == "bar" else [ww, tt] + (
+        [slice(3 * n, blocks * n)] if kind == "frame" else [])
+    rows = [-A[part] for part in linear]            # k ≥ m: s = p - m + A w ≥ 0
+    cones = [clarabel.NonnegativeConeT(sum(r.shape[0] for r in rows))]
+    if kind != "bar":                                # s = (a + b, 2c, 2√m, a - b) in the cone
+        a, c, b = A[ww], A[wt], A[tt]
+        rows.append(-np.stack([a + b, 2 * c, np.zeros_like(a), a - b], axis=1)
+                    .reshape(4 * n, m))
+        cones += [clarabel.SecondOrderConeT(4)] * n
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = 1e-10
+    P, A_c = sp.identity(m, format="csc"), sp.csc_matrix(np.vstack(rows))
+    bound, iterations = margin + REDUCED_LIFT, 0
+    for _ in range(2):
+        rhs = [p[part] - bound for part in linear]
+        if kind != "bar":
+            rhs.append(np.stack([p[ww] + p[tt], 2 * p[wt], np.full(n, 2 * np.sqrt(bound)),
+                                 p[ww] - p[tt]], axis=1).ravel())
+        solution = clarabel.DefaultSolver(P, np.zeros(m), A_c, np.concatenate(rhs), cones,
+                                          settings).solve()
+        iterations += int(solution.iterations)
+        if str(solution.status) != "Solved":
+            return None, None
+        w = np.asarray(solution.x)
+        g = np.concatenate(_condition_values(p + A @ w, n, kind))
+        short = margin + REDUCED_LIFT - float(g.min())
+        if short <= 0.5 * REDUCED_LIFT:
+            return {"x": w, "g": g}, {"solver": "clarabel",
+                                      "return_status": str(solution.status),
+                                      "iter_count": iterations}
+        bound += 2.0 * short
+    return None, None
+
+
+def _ipopt_reduced(p, A, n: int, kind: str, margin: float, max_iter: int):
+    """The reduced problem of :func:`_solve_reduced` by IPOPT, the conditions as CasADi
+    expressions (:func:`_condition_values`) held margin + :data:`REDUCED_LIFT` or above.
+    Returns ({"x", "g"}, info) or (None, None)."""
+    # MX, not SX: the conditions read dense affine maps of w, and SX expands them into
+    # scalar graphs from which IPOPT's solver is built with a dense symbolic Hessian
+    # (~rows × n² nodes): on the semi-rigid portal's generic update, building its 21
+    # solvers took 6.8 s; as matrix products 0.15 s (parameters the same to 7e-9)
+    w = ca.MX.sym("w", A.shape[1])
+    values = _condition_values(ca.DM(p) + ca.mtimes(ca.DM(A), w), n, kind)
+    problem = {"x": w, "f": 0.5 * ca.sumsqr(w), "g": ca.vertcat(*values)}
+    # IPOPT twice: from the direct point, then from its point with the objective scaled
+    # to one there (its stopping rule is absolute, and a step that a few elements cross
+    # may cost 1e-5 of the objective: measured, the first solve's objective 1e-5 above
+    # a conic solver's, the second's within 1e-8, in 10-15 more iterations)
+    sol, info, scaling, iterations = None, None, 1.0, 0
+    for _ in range(2):
+        solver = ca.nlpsol("reduced_step", "ipopt", problem, {
+            "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
+            "ipopt.mu_strategy": "adaptive", "ipopt.max_iter": max_iter,
+            "ipopt.tol": 1e-10, "ipopt.acceptable_tol": 1e-8,
+            "ipopt.obj_scaling_factor": scaling,
+            # the conditions as stated (IPOPT relaxes them by 1e-8): the step's point
+            # satisfies them strictly, as a direct one does
+            "ipopt.bound_relax_factor": 0.0})
+        try:
+            out = solver(x0=np.zeros(A.shape[1]) if sol is None else sol["x"],
+                         lbg=margin + REDUCED_LIFT, ubg=np.inf)
+        except RuntimeError:
+            return None, None
+        if not solver.stats().get("success"):
+            if sol is None:
+                return None, None
+            break    # (the first solve's point stands)
+        sol, info = out, solver.stats()
+        iterations += int(info.get("iter_count", 0))
+        scaling = 1.0 / max(float(sol["f"]), 1e-300)
+    return ({"x": np.array(sol["x"]).ravel(), "g": np.array(sol["g"]).ravel()},
+            {"solver": "ipopt", "return_status": str(info.get("return_status")),
+             "iter_count": iterations})
 
 
 def _solve_step(pb: _Problem, x_start, max_iter: int, solver: str):
@@ -964,7 +1043,7 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
     pb = prepare()
     notes = []
     (success, status, info), (x_opt, phi_opt), used = _solve_step(pb, pb.x0, max_iter, solver)
-    solvers = [used]
+    solvers, reduced_by = [used], list(info.get("reduced_solvers", []))
     for done in range(refinements if full_shapes is None else 0):
         if not success:
             break
@@ -973,6 +1052,7 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
         (success, status, info), (x_new, phi_opt), used = _solve_step(pb, x_opt, max_iter,
                                                                       solver)
         solvers.append(used)
+        reduced_by += info.get("reduced_solvers", [])
         step = np.max(np.abs(x_new - x_opt) / pb.x_scale)
         x_opt = x_new
         info["refinements"] = done + 1
@@ -984,8 +1064,11 @@ def update_generic(model: Model | Discretisation, measured: MeasuredModes, *,
         (success, status, info), (x_opt, phi_opt) = _solve_ipopt(pb, method, x_opt, max_iter)
         solvers.append("ipopt")
     info["steps"] = solvers
-    ipopt = "ipopt" in solvers or "reduced" in solvers
-    result = _finish(pb, method, "ipopt" if ipopt else "direct", x_opt, phi_opt,
+    # the solver of the hardest problem solved: IPOPT (on a whole or a reduced step), else
+    # Clarabel (on reduced steps), else the direct factorisation alone
+    by = "ipopt" if "ipopt" in solvers or "ipopt" in reduced_by else (
+        "clarabel" if "reduced" in solvers else "direct")
+    result = _finish(pb, method, by, x_opt, phi_opt,
                      status, success, info, time.perf_counter() - start, notes)
     result.stats = {**(result.stats or {}), "weighting": weighting}
     return result

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from gfe_opt import elements as el
+from gfe_opt import updating
 from gfe_opt.assembly import discretise
 from gfe_opt.measured import make_measured
 from gfe_opt.modal import discretisation_modes
@@ -148,20 +149,22 @@ def _conic_step(model, measured, shapes, margin, parameterisation):
     return pb.x_scale * z.value, P @ z.value, objective
 
 
-def test_active_constraint_is_solved_on_the_reduced_problem():
+@pytest.mark.parametrize("reduced_by", ["clarabel", "ipopt"])
+def test_active_constraint_is_solved_on_the_reduced_problem(reduced_by, monkeypatch):
     # a margin the 30 % dip must cross: the direct KKT point is infeasible, so "auto" solves
-    # the step as the small problem of the elements it breaks (IPOPT on it); its point sits
-    # on the bound, satisfies every condition, and is the convex step's optimum: another
-    # method (a conic solver) finds it too, and IPOPT on the whole step within its own
-    # accuracy (it relaxes the bounds by 1e-8 and stops at a tolerance of 1e-8: 2.4e-7 of
-    # the largest parameter here; 2e-4 relative on a parameter near zero with no bound
-    # active at all)
+    # the step as the small problem of the elements it breaks (its cone program by Clarabel,
+    # or IPOPT on it); its point sits on the bound, satisfies every condition, and is the
+    # convex step's optimum: another method (a conic solver on the whole step) finds it too,
+    # and IPOPT on the whole step within its own accuracy (it relaxes the bounds by 1e-8 and
+    # stops at a tolerance of 1e-8: 2.4e-7 of the largest parameter here; 2e-4 relative on a
+    # parameter near zero with no bound active at all)
+    monkeypatch.setattr(updating, "REDUCED_SOLVER", reduced_by)
     model = make_model(elements=20)
     measured, shapes = _all_dof_data(model, _dip(model), 3)
     auto = update_generic(model, measured, full_shapes=shapes, noise=0.0, margin=3.5)
     forced = update_generic(model, measured, full_shapes=shapes, noise=0.0, margin=3.5,
                             solver="ipopt")
-    assert auto.stats["steps"] == ["reduced"] and auto.solver == "ipopt", auto.summary()
+    assert auto.stats["steps"] == ["reduced"] and auto.solver == reduced_by, auto.summary()
     assert auto.ok and not auto.violations
     assert active_constraints(auto) == active_constraints(forced) != []
     conic, _, _ = _conic_step(model, measured, shapes, 3.5, auto.parameterisation)
@@ -172,7 +175,9 @@ def test_active_constraint_is_solved_on_the_reduced_problem():
     assert free.solver == "direct" and not active_constraints(free)
 
 
-def test_reduced_step_frees_the_neighbours_a_binding_condition_pushes_on():
+@pytest.mark.parametrize("reduced_by", ["clarabel", "ipopt"])
+def test_reduced_step_frees_the_neighbours_a_binding_condition_pushes_on(reduced_by,
+                                                                         monkeypatch):
     # a 40-element bar updated from its closed-form modes with a margin of 0.99 of its
     # rigidity: the direct point breaks the last 6 elements, the optimum holds 7 at the bound
     # (a neighbour's condition binds in the first small problem, and it reads a parameter
@@ -181,10 +186,12 @@ def test_reduced_step_frees_the_neighbours_a_binding_condition_pushes_on():
     # bound set and objective; the parameters agree to 4.4e-5 of the largest, along a
     # direction whose curvature is 5e-9 of the largest (the reduced problem holds its bounds
     # 1e-9 above the margin, which that direction amplifies)
+    monkeypatch.setattr(updating, "REDUCED_SOLVER", reduced_by)
     bar = make_model(STEEL_BAR, elements=40)
     measured, shapes = _exact_bar_modes(bar, 3)
     auto = update_generic(bar, measured, full_shapes=shapes, noise=0.0, margin=0.99)
     assert auto.stats["steps"] == ["reduced"] and auto.ok and not auto.violations
+    assert auto.solver == reduced_by
     qp, p, objective = _conic_step(bar, measured, shapes, 0.99, auto.parameterisation)
     held = np.flatnonzero(auto.element_parameters["k"] / auto.k0 - 0.99 < 1e-7)
     assert held.tolist() == np.flatnonzero(p - 0.99 < 1e-7).tolist()
