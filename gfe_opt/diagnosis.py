@@ -63,6 +63,7 @@ Verdict
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import copy
 import multiprocessing
 import os
@@ -659,12 +660,20 @@ def _reused_jobs(jobs, progress, labels, reuse: dict) -> list:
     return out
 
 
+#: the running diagnosis's ``progress`` (per thread of a batch's or Dask's workers): every
+#: batch of fits reports to it, the pairs and readings after the candidates too (the
+#: semi-rigid portal's command said nothing for its last 30 s of 60, stop 79)
+_PROGRESS = contextvars.ContextVar("gfe_opt_diagnosis_progress", default=None)
+
+
 def _run_jobs(jobs, progress, labels):
     """Run fits, in parallel over the machine's cores (fork, one BLAS thread per worker;
     serial where processes cannot be forked or only one core is there); results in order.
+    ``progress`` None: the running diagnosis's (:data:`_PROGRESS`).
     A frame's candidates run as a job a member first (:func:`_group_jobs`), then a job a
     candidate that takes its members' fits on (:func:`_fit_candidate`, with ``fits``):
     the same fits, the cores kept busy."""
+    progress = progress or _PROGRESS.get()
     split, owner = _group_jobs(jobs)
     if len(split) == len(jobs):
         return _pool_jobs(jobs, progress, labels)
@@ -688,6 +697,8 @@ def _pool_jobs(jobs, progress, labels):
     """:func:`_run_jobs`'s jobs as they are, in the pool (or serially)."""
     workers = 1 if SERIAL_FITS else min(len(jobs), os.cpu_count() or 1)
     results = [None] * len(jobs)
+    if not jobs:
+        return results
     if progress:
         progress(0, len(jobs), "")
     try:
@@ -902,9 +913,13 @@ def diagnose(model: Model, measured: MeasuredModes, *, candidates=None,
     frequencies alone from every start, as a pair is); None: the diagnosis decides
     (:func:`_again_thorough`)."""
     start = time.perf_counter()
-    with shared_pool():
-        result, names, second, again = _passes(model, measured, candidates, freq_noise,
-                                               shape_noise, progress, realise, thorough)
+    token = _PROGRESS.set(progress)
+    try:
+        with shared_pool():
+            result, names, second, again = _passes(model, measured, candidates, freq_noise,
+                                                   shape_noise, progress, realise, thorough)
+    finally:
+        _PROGRESS.reset(token)
     if again:
         # it stands only where it names what explains the difference to the noise: a
         # partial finding from another valley is no reason to withdraw "unexplained" (a
@@ -1511,7 +1526,8 @@ def _swap(model, measured, noise, reference, names, sel):
             alts.append(name)
         jobs = [("candidate", (base, measured, name, noise, hint)) for name in alts]
         closest = None
-        for alt in _run_jobs(jobs, None, alts) if jobs else []:
+        for alt in _run_jobs(jobs, None, [f"{a} in place of {effect.name}" for a in alts]) \
+                if jobs else []:
             if not alt.success or alt.unidentified:
                 continue
             if closest is None or sel.penalised(alt) < sel.penalised(closest):
@@ -1716,7 +1732,8 @@ def _simplest_first(model, measured, noise, hint, explains, sel, first, pair, ot
                            None, (Effect(f.name, f.parameters),), []))
             for f in others]
     best = (first, pair)
-    for f, alt in zip(others, _run_jobs(jobs, None, [f.name for f in others])):
+    labels = [f"{f.name} + {f.name if repeat else pair.name}" for f in others]
+    for f, alt in zip(others, _run_jobs(jobs, None, labels)):
         if not alt.success or alt.unidentified:
             continue
         if sel.better(alt, f):
@@ -1740,7 +1757,8 @@ def _pairs_with(model, measured, noise, best, fits, hint, explains, sel):
     jobs = [("candidate", (model, measured, name, noise, hint, None, (first,),
                            [alone[name]] if name in alone else []))
             for name in seconds]
-    pairs = [p for p in _run_jobs(jobs, None, seconds) if p.success and not p.unidentified]
+    pairs = [p for p in _run_jobs(jobs, None, [f"{best.name} + {name}" for name in seconds])
+             if p.success and not p.unidentified]
     explaining = [p for p in pairs if explains(p)]
     return (_rank(explaining, sel)[0] if explaining else None), pairs
 

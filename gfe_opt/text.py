@@ -269,9 +269,13 @@ def terminal_progress(enabled: bool = True):
     if not (enabled and sys.stderr.isatty()):
         return None
 
+    width = [28]   # the longest line yet: a shorter one is padded over it
+
     def report(done, total, name):
         end = "\n" if done == total else ""
-        print(f"\rfitting: {done}/{total} {name:<28}", end=end, file=sys.stderr, flush=True)
+        line = f"fitting: {done}/{total} {name}"
+        width[0] = max(width[0], len(line))
+        print(f"\r{line:<{width[0]}}", end=end, file=sys.stderr, flush=True)
 
     return report
 

@@ -65,8 +65,20 @@ the regularisation holds it at its initial value).
     form), side by side at each size (best of alternated runs, one BLAS thread), and the
     free DOFs from which the sparse route is the faster at every size measured.
 
+11. The reduced step's solver (stop 79), ``--parts reduced``: the generic update's small
+    problems (:func:`gfe_opt.updating._solve_reduced`) by IPOPT and by Clarabel
+    (``updating.REDUCED_SOLVER``), side by side in one process, alternated: the semi-rigid
+    portal's generic update (best of 3); the updates of its realisation's 12 noisy copies
+    (the model's own modes and the finding's, as ``gfe-opt diagnose`` runs them: the
+    copies taken from one diagnosis; serial, one BLAS thread; best of 2); the whole
+    ``diagnose`` with the realisation on the portal (as the command runs it, in the pool;
+    one run each); the 2 000-element beam's ``diagnose`` with the realisation (one run
+    each).  Each row: time, reduced steps by solver and steps sent whole to IPOPT, and the
+    largest difference of the updated parameters (relative to the largest) between the
+    two; the diagnoses' verdicts and words.
+
 ``--parts`` runs a subset: update, ratio, solvers, accuracy, diagnose, scale, fits, frames,
-shapes, dense (the default: all but shapes and dense).
+shapes, dense, reduced (the default: all but shapes, dense and reduced).
 """
 
 import argparse
@@ -177,6 +189,8 @@ def main():
         _shapes(out)
     if "dense" in parts:
         _dense_or_sparse(out)
+    if "reduced" in parts:
+        _reduced(out)
     print(json.dumps(out, indent=1))
 
 
@@ -330,6 +344,105 @@ def _dense_or_sparse(out):
             at = next((r["free_dofs"] for i, r in enumerate(mine) if all(faster[i:])), None)
             first[f"{kind}_{what}"] = at
     out["dense_or_sparse"] = {"rows": rows, "sparse_faster_from_free_dofs": first}
+
+
+def _reduced(out):
+    """Part 11 (module docstring)."""
+    from collections import Counter
+
+    import gfe_opt.diagnosis as diagnosis
+    import gfe_opt.updating as updating
+    from gfe_opt.diagnosis import diagnose
+    from gfe_opt.model import Effect, load_model
+    from gfe_opt.problems import portal_frame, problem_file
+    from gfe_opt.structure import structure
+    from gfe_opt.synthetic import interior_sensors, synthetic_measurement
+    from gfe_opt.threads import one_thread_limits
+
+    portal = portal_frame()
+    layout = structure(portal)
+    measured, _, _ = layout.prepared(
+        layout.load_measured(problem_file("portal-frame-semirigid.json")))
+    noise = diagnosis.noise_of(None, None)
+    tally, solve_step = Counter(), updating._solve_step
+
+    def counted(*args, **kwargs):
+        step = solve_step(*args, **kwargs)
+        info = step[0][2] or {}
+        tally[step[2]] += 1
+        tally.update(f"reduced by {s}" for s in info.get("reduced_solvers", []))
+        return step
+
+    updating._solve_step = counted
+    copies, draw = [], diagnosis._draw
+
+    def keep(model, data, noise_):   # the copies one diagnosis reads, to time them again
+        copies.append((model, data, noise_))
+        return draw(model, data, noise_)
+
+    diagnosis._draw, serial = keep, diagnosis.SERIAL_FITS
+    diagnosis.SERIAL_FITS = True
+    try:
+        diagnose(portal, layout.load_measured(problem_file("portal-frame-semirigid.json")),
+                 realise=True)
+    finally:
+        diagnosis._draw, diagnosis.SERIAL_FITS = draw, serial
+    beam = load_model(problem_file("ss-steel-beam.toml"))
+    big = beam.with_elements(2000)
+    truth = beam.with_effects([Effect("crack", {"position": 0.19, "depth_ratio": 0.5})])
+    big_measured = synthetic_measurement(truth.with_elements(2000), 5,
+                                         interior_sensors(beam.length, 45), shape_noise=0.003,
+                                         freq_noise=0.0005, seed=2002, reference_elements=4000)
+
+    def side(solver):
+        def run(fn):
+            def timed():
+                updating.REDUCED_SOLVER = solver
+                tally.clear()
+                result = fn()
+                return result, dict(tally)
+            return timed
+        return run
+
+    rows = {}
+    solvers = ("ipopt", "clarabel")
+
+    def ratios(results):
+        return [None if r is None else np.asarray(r) for r in results]
+
+    def compare(label, fn, repeats, read):
+        best, results = _alternated([side(s)(fn) for s in solvers], repeats)
+        values = [read(r[0]) for r in results]
+        diff = None
+        if all(v is not None for v in values):
+            scale = max(float(np.max(np.abs(values[0]))), 1e-300)
+            diff = float(np.max(np.abs(values[0] - values[1]))) / scale
+        rows[label] = {**{f"{s}_s": round(b, 3) for s, b in zip(solvers, best)},
+                       "speedup": round(best[0] / best[1], 2),
+                       "steps": {s: r[1] for s, r in zip(solvers, results)},
+                       "max_rel_difference": diff}
+        return [r[0] for r in results]
+
+    with one_thread_limits():
+        compare("portal_generic_update", lambda: layout.generic_update(measured, noise), 3,
+                lambda r: r.q)
+        compare("portal_realisation_draws",
+                lambda: [diagnosis._draw(*c) for c in copies], 2,
+                lambda r: np.concatenate([np.full(1, np.nan) if d is None else d
+                                          for d in ratios(r)]))
+    for label, model, data, stated in (
+            ("portal_diagnose", portal,
+             layout.load_measured(problem_file("portal-frame-semirigid.json")), {}),
+            ("diagnose_2000", big, big_measured,
+             {"freq_noise": 0.0005, "shape_noise": 0.003})):
+        done = compare(label, lambda m=model, d=data, k=stated: diagnose(m, d, realise=True,
+                                                                         **k),
+                       1, lambda r: None)
+        rows[label]["steps"] = "in the pool's workers (not counted)"
+        rows[label]["verdicts"] = [d.verdict for d in done]
+        rows[label]["same_words"] = done[0].realisation == done[1].realisation
+    updating._solve_step = solve_step
+    out["reduced"] = {"rows": rows, "copies": len(copies)}
 
 
 def _ratio(out):

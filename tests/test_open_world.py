@@ -36,6 +36,21 @@ def test_two_cracks_are_two_local_losses_then_consistent():
     assert abs(losses[0] - 0.12) <= 0.015 and abs(losses[1] - 0.42) <= 0.015
 
 
+def test_the_pairs_after_the_candidates_are_reported_as_progress():
+    # two cracks: the first alone does not explain the data, so the diagnosis fits it with
+    # each other candidate (its lookahead) after the candidates' batch; those fits report
+    # to the same progress as the candidates, each batch counted to its end
+    measured = reference_data(rigidity=product(christides_barr(0.12, 0.4),
+                                               christides_barr(0.42, 0.4)))
+    calls = []
+    result = diagnose(make_model(), measured, progress=lambda *a: calls.append(a), **NOISE)
+    assert result.suggested[0] in LOCAL_LOSSES
+    pairs = [name for _, _, name in calls if name.startswith(f"{result.best.name} + ")]
+    assert pairs and f"{result.best.name} + {result.best.name}" in pairs
+    ends = [(done, total) for done, total, _ in calls if done == total]
+    assert len(ends) >= 2 and all(total > 0 for _, total in ends)   # the candidates, pairs
+
+
 def test_a_taper_becomes_a_stiffness_profile_not_local_effects():
     measured = reference_data(rigidity=lambda x: 1.0 - 0.2 * x / L)
     added, last, model = loop(make_model(), measured, steps=3)
