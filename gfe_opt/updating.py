@@ -863,6 +863,12 @@ def _conic_reduced(p, A, n: int, kind: str, margin: float):
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = 1e-10
+    # one thread, QDLDL: its default factorisation (faer) starts a pool of threads in this
+    # process on larger problems, and a pool of fits forked from it after that waited for
+    # ever on them (the bench's portal diagnosis after an update in process, stop 79);
+    # sequential, the same rounding on every run
+    settings.max_threads = 1
+    settings.direct_solve_method = "qdldl"
     P, A_c = sp.identity(m, format="csc"), sp.csc_matrix(np.vstack(rows))
     bound, iterations = margin + REDUCED_LIFT, 0
     for _ in range(2):

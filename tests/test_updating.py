@@ -1,5 +1,7 @@
 """Equation-error updating: recovery of known rigidity, the case-study crack, IPOPT vs SDP."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -317,3 +319,31 @@ def test_bad_update_options_are_refused(options, message):
     measured, shapes = _all_dof_data(model, _taper(model), 2)
     with pytest.raises(ValueError, match=message):
         update_generic(model, measured, **options)
+
+
+def _threads() -> int:
+    return len(os.listdir(f"/proc/{os.getpid()}/task"))
+
+
+@pytest.mark.skipif(not os.path.isdir(f"/proc/{os.getpid()}/task"), reason="needs /proc")
+def test_the_reduced_cone_program_is_ipopts_problem_and_starts_no_threads():
+    # a frame member's reduced problem (30 elements, 90 free parameters; random conditions,
+    # some broken): Clarabel's cone program and IPOPT on the conditions as CasADi
+    # expressions reach the same optimum, every condition held above the margin.  Clarabel
+    # runs on this thread alone: with its defaults this problem started two threads in the
+    # process (faer's pool), and a pool of fits forked after such a solve waited for ever
+    rng = np.random.default_rng(1)
+    n, m, margin = 30, 90, 1e-3
+    p = np.concatenate([rng.uniform(-0.5, 2, n), rng.uniform(-0.3, 0.3, n),
+                        rng.uniform(0.5, 2, n), rng.uniform(-0.5, 2, n)])
+    A = rng.standard_normal((4 * n, m))
+    before = _threads()
+    conic, info = updating._conic_reduced(p, A, n, "frame", margin)
+    assert _threads() == before
+    ipopt, _ = updating._ipopt_reduced(p, A, n, "frame", margin, 500)
+    assert info["solver"] == "clarabel" and conic is not None and ipopt is not None
+    g = np.concatenate(updating._condition_values(p + A @ conic["x"], n, "frame"))
+    assert np.min(g) > margin and np.min(p) < margin        # broken before, held after
+    f_conic, f_ipopt = 0.5 * conic["x"] @ conic["x"], 0.5 * ipopt["x"] @ ipopt["x"]
+    assert abs(f_conic / f_ipopt - 1) < 1e-7                                 # 1.6e-10
+    assert np.max(np.abs(conic["x"] - ipopt["x"])) < 1e-4 * np.max(np.abs(ipopt["x"]))  # 1.8e-6
