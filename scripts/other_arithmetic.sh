@@ -2,8 +2,8 @@
 # The same answers under other arithmetic (issue 20): the tests that carry a decision of
 # the tool (the real-data loop and the demo with their README output, the diagnosis and
 # frequency-only tests, the open-world, free-free and figure tests, identification, the batch
-# table, the shipped examples) run again under other OpenBLAS kernels and with one BLAS
-# thread; each run must pass.  Sandybridge (AVX) and Haswell (AVX2) run on any x86-64 machine of this kind;
+# table, the shipped examples, the generic update's solvers) run again under other OpenBLAS
+# kernels and with one BLAS thread; each run must pass.  Sandybridge (AVX) and Haswell (AVX2) run on any x86-64 machine of this kind;
 # SkylakeX (AVX-512) only where the processor has it.  `--full` runs the whole suite under
 # each setting instead of the decision tests.
 #
@@ -25,6 +25,7 @@ DECISIONS=(
     tests/test_frame_generic.py
     tests/test_frame_profile.py
     tests/test_realisation.py
+    tests/test_updating.py
     tests/test_screening.py
     tests/test_fitting_numerics.py
     tests/test_scripts.py::test_shipped_examples_are_what_the_script_writes
