@@ -364,7 +364,7 @@ def _reduced(out):
     measured, _, _ = layout.prepared(
         layout.load_measured(problem_file("portal-frame-semirigid.json")))
     noise = diagnosis.noise_of(None, None)
-    tally, solve_step = Counter(), updating._solve_step
+    tally, solve_step, chosen = Counter(), updating._solve_step, updating.REDUCED_SOLVER
 
     def counted(*args, **kwargs):
         step = solve_step(*args, **kwargs)
@@ -415,8 +415,8 @@ def _reduced(out):
         values = [read(r[0]) for r in results]
         diff = None
         if all(v is not None for v in values):
-            scale = max(float(np.max(np.abs(values[0]))), 1e-300)
-            diff = float(np.max(np.abs(values[0] - values[1]))) / scale
+            scale = max(float(np.nanmax(np.abs(values[0]))), 1e-300)   # (a failed draw: nan)
+            diff = float(np.nanmax(np.abs(values[0] - values[1]))) / scale
         rows[label] = {**{f"{s}_s": round(b, 3) for s, b in zip(solvers, best)},
                        "speedup": round(best[0] / best[1], 2),
                        "steps": {s: r[1] for s, r in zip(solvers, results)},
@@ -441,7 +441,7 @@ def _reduced(out):
         rows[label]["steps"] = "in the pool's workers (not counted)"
         rows[label]["verdicts"] = [d.verdict for d in done]
         rows[label]["same_words"] = done[0].realisation == done[1].realisation
-    updating._solve_step = solve_step
+    updating._solve_step, updating.REDUCED_SOLVER = solve_step, chosen
     out["reduced"] = {"rows": rows, "copies": len(copies)}
 
 
