@@ -63,8 +63,8 @@ equality problem on the same factorisation, affine in them, so the step reduces 
 quadratic in a few parameters under the conditions of the elements they move, a
 second-order cone program that Clarabel solves, IPOPT where Clarabel does not (whitened,
 the conditions held 1e-9 above the margin; :func:`_conic_reduced`, :func:`_ipopt_reduced`;
-on the semi-rigid portal's realisation 10x faster than IPOPT alone, which took 100-500
-iterations there and stopped at its limit on some); elements still broken, and
+on the semi-rigid portal's realisation 10x faster than IPOPT alone, which took up to 500
+iterations there and stopped at that limit on some); elements still broken, and
 elements whose condition binds there but which read a parameter outside it, free their
 parameters too, until neither is left (then the small problem's optimality conditions are
 the step's).  Measured: a 2000-element draw of the realisation whose two refinements broke
