@@ -643,7 +643,8 @@ REDUCED_SIZE = 200
 #: condition strictly, as a direct one does (IPOPT on the whole step relaxes them by 1e-8)
 REDUCED_LIFT = 1e-9
 #: a condition of the reduced problem within this of its margin binds (IPOPT's interior
-#: point leaves a binding one 1e-10 above its bound; a condition counted binding that is not
+#: point leaves a binding one 1e-10 above its bound, Clarabel's a few 1e-9 where its bound
+#: was raised, :func:`_conic_reduced`; a condition counted binding that is not
 #: only makes the problem larger)
 REDUCED_BINDING = 1e-7
 
