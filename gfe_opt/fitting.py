@@ -973,7 +973,7 @@ def _minimise(residual, chi2, z_start, lower, upper, max_iter):
     converges on the same beam at :data:`~gfe_opt.modal.CONDENSE_ABOVE` elements (direct
     solves, the analytic Jacobian: the screen's stand-in) and the finish on its own mesh
     starts there; its optimum is the same to the discretisation's difference, so the finish
-    takes a step or two of differenced Jacobians where from the grid point it took five
+    takes two or three differenced Jacobians where from the grid point it took five
     (the stand-in only moves the start: the end meets the finish's rule on the fit's own
     mesh as before)."""
     stand_in = getattr(residual, "stand_in", None)
