@@ -219,3 +219,29 @@ def test_a_condensed_beams_fit_converges_first_on_its_stand_in(monkeypatch):
         assert abs(fit.effects[0].parameters[key] - value) < 1e-3 * fit.sigma[0][key]
     assert fine <= 0.6 * fine_plain
     assert abs(fit.effects[0].parameters["position"] - 0.27) < 0.01
+
+
+def test_shear_on_a_beam_the_condensation_cannot_take_is_fitted():
+    """A deep beam (L/h = 12) of 400 elements measured from the Timoshenko closed form
+    (six modes, 30 sensors, noise): the shear fit converges to the noise with κGA within
+    1 % of the truth's 5/6 G A (0.08 % when written).  Before its modal solve fell back to
+    the direct route, every shear model the fit tried at this mesh failed the condensed
+    route's check and the fit ended not converged, κGA 155 % off."""
+    from gfe_opt.measured import make_measured
+
+    from .conftest import make_model
+    from .reference import add_noise, interior, timoshenko_ss
+
+    length = 0.575
+    model = make_model(section={"b": 0.02, "h": length / 12}, elements=400)
+    kga = 5 / 6 * model.E / (2 * (1 + model.nu)) * model.area
+    s = interior(length, 30)
+    f = timoshenko_ss(6, model.bending_rigidity, model.mass_per_length,
+                      model.rho * model.inertia, kga, length)
+    f, y = add_noise(f, np.sin(np.outer(s, np.arange(1, 7) * np.pi / length)), seed=4,
+                     shape_noise=0.003, freq_noise=0.0005)
+    fit = fitting.fit_effects(model, make_measured(s, "w", f, y, "timoshenko"),
+                              [Effect("shear", {})], noise=NOISE)
+    assert fit.success and fit.status == "converged"
+    assert fit.misfit.chi2_per_residual < 1.5
+    assert abs(fit.effects[0].parameters["shear_rigidity"] / kga - 1) < 0.01
