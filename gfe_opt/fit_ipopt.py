@@ -75,12 +75,11 @@ class _GaussNewton(ca.Callback):
         if self._point is None or self._point[0] != key:
             r0 = self.fun(z)
             analytic = getattr(self.residual, "jacobian", None)
-            if analytic is not None:   # IPOPT may step a hair outside the bounds
-                inside = np.clip(z, self.lower, self.upper)
-                jac = analytic(inside, r0, self.lower, self.upper) / self.root \
-                    if np.array_equal(inside, z) else self._forward(z, r0)
-            else:
-                jac = self._forward(z, r0)
+            inside = np.clip(z, self.lower, self.upper)
+            jac = None   # IPOPT may step a hair outside the bounds: differences there
+            if analytic is not None and np.array_equal(inside, z):
+                jac = analytic(inside, r0, self.lower, self.upper)   # (None: condensed)
+            jac = self._forward(z, r0) if jac is None else jac / self.root
             self._point = (key, r0, jac)
         return self._point[1], self._point[2]
 

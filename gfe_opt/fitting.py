@@ -525,7 +525,8 @@ class Objective:
     """The residual r(z) of a fit, counted, the last evaluation kept (the Jacobian at a
     point reuses its modal solve); ``jacobian(z, r, lower, upper)`` is the analytic one
     (:func:`point_jacobian`, falling back to differences of r where the modes have no
-    derivative), None when fits difference the residual itself."""
+    derivative; None at a point whose modes came from the condensed route, which the caller
+    differences with its own step), None when fits difference the residual itself."""
 
     def __init__(self, model_at, measured, noise, C, analytic: bool = True, owner=None):
         self.model_at, self.measured, self.noise, self.C = model_at, measured, noise, C
@@ -578,6 +579,11 @@ class Objective:
             return self._last_jacobian[1]
         J = None
         point = self.point(z)
+        if point is not None and point.modes.condensed:
+            # the residual of the condensed route's approximate shapes: the caller
+            # differences it, as where no analytic Jacobian is given (a shear beam's route
+            # turns on its parameters: one fit may see both)
+            return None
         if point is not None:
             try:
                 J = point_jacobian(point, z, self.model_at, self.measured, self.noise, lower,
@@ -707,7 +713,7 @@ def fit_problem(model: Model, measured: MeasuredModes, adding=(), *, noise: Nois
     owner = [j for j, s in enumerate(slots) for _ in s.variables]
     problem.residual = Objective(
         lambda z: base.with_effects(problem.effects_of(z), check=False), measured, noise, C,
-        wanted and not condensed(base), owner=owner)
+        wanted, owner=owner)
     if condensed(base) and STAND_IN:
         # the same beam at the finest mesh solved directly, where the fit converges first
         # (:func:`_minimise`); its own sensor matrix
@@ -932,8 +938,10 @@ def _profile_starts(residual, chi2, z0, grids, slots, lower, upper, nulls=None) 
         z = np.concatenate([z0[inner], point])
         r = residual(z)
         for _ in range(PROFILE_STEPS):
-            if getattr(residual, "jacobian", None) is not None:
-                J = residual.jacobian(z, r, lower, upper, columns=inner)[:, inner]
+            analytic = getattr(residual, "jacobian", None)
+            J = None if analytic is None else analytic(z, r, lower, upper, columns=inner)
+            if J is not None:
+                J = J[:, inner]
             else:
                 J = np.empty((r.size, inner.size))
                 for k in inner:
@@ -1031,9 +1039,8 @@ SOLVER_TALLY: Counter = Counter()
 def _jacobian(residual, z, r, lower, upper, step: float = 1e-5):
     """The residual's own Jacobian (:class:`Objective`) or :func:`_difference_jacobian`."""
     analytic = getattr(residual, "jacobian", None)
-    if analytic is not None:
-        return analytic(z, r, lower, upper)
-    return _difference_jacobian(residual, z, r, lower, upper, step)
+    J = None if analytic is None else analytic(z, r, lower, upper)
+    return _difference_jacobian(residual, z, r, lower, upper, step) if J is None else J
 
 
 def _difference_jacobian(residual, z, r, lower, upper, step: float = 1e-5):

@@ -5,8 +5,10 @@ what double precision holds near N = 10⁵ (and shift-invert eigenvalues lose ep
 at 10⁴).  Two routes, both ending in Rayleigh quotients whose strain energy is summed
 element by element from relative deformations (no cancellation):
 
-* **direct** (bars, and beams up to :data:`CONDENSE_ABOVE` elements): the free-DOF matrices
-  scaled by :math:`D = \mathrm{diag}(M)^{-1/2}`, a dense generalised solver up to
+* **direct** (bars, beams up to :data:`CONDENSE_ABOVE` elements, and longer shear beams
+  whose pencil is conditioned no worse than the Euler–Bernoulli beam's at that mesh,
+  :data:`DIRECT_CONDITIONING`: with rotary inertia the conditioning grows as N²): the
+  free-DOF matrices scaled by :math:`D = \mathrm{diag}(M)^{-1/2}`, a dense generalised solver up to
   :data:`DENSE_LIMIT` DOFs, else shift-invert below the spectrum
   (:math:`σ = -λ_{ref}`, :math:`λ_{ref}` = EI/(ρA L⁴) or EA/(ρA L²): positive definite,
   free–free structures need no special case) from a fixed start vector.  Check: the
@@ -53,6 +55,11 @@ from .threads import one_blas_thread
 DENSE_LIMIT = 1500
 #: Beams with more elements are solved through condensed super-elements.
 CONDENSE_ABOVE = 200
+#: The direct route's conditioning limit, max K_ii/M_ii over the eigenvalue scale EI/(ρA L⁴):
+#: the consistent-mass Euler–Bernoulli beam's at CONDENSE_ABOVE elements (the rotation's
+#: 8EI/h over 8ρAh³/420: 420 N⁴).  A shear beam below it is solved directly
+#: (:func:`condensed`).
+DIRECT_CONDITIONING = 420.0 * CONDENSE_ABOVE**4
 #: Largest relative residual ‖(K − λM)φ‖ / ‖λMφ‖ a direct solve may leave.
 RESIDUAL_TOLERANCE = 1e-3
 #: Largest change of a Rayleigh quotient by the dynamic correction of the condensed shapes.
@@ -70,6 +77,9 @@ class Modes:
 
     frequencies_hz: np.ndarray
     shapes: np.ndarray
+    #: from the condensed route (:func:`_condensed_modes`): approximate shapes, whose
+    #: residual the eigen-derivatives do not differentiate
+    condensed: bool = False
 
     @property
     def omega(self) -> np.ndarray:
@@ -319,9 +329,27 @@ def peak_rows(shapes) -> np.ndarray:
 
 def condensed(model) -> bool:
     """Whether the modes of ``model`` (a Model or a Discretisation) come from the condensed
-    route (:func:`_condensed_modes`)."""
+    route (:func:`_condensed_modes`): an Euler–Bernoulli beam above :data:`CONDENSE_ABOVE`
+    elements, a shear beam there only if its pencil is conditioned worse than that
+    (:func:`_shear_beam_condensed`)."""
     n = model.elements if hasattr(model, "elements") else model.n_elements
-    return model.kind == "beam" and n > CONDENSE_ABOVE
+    if model.kind != "beam" or n <= CONDENSE_ABOVE:
+        return False
+    disc = model if isinstance(model, Discretisation) else discretise(model)
+    return disc.shear_g is None or _shear_beam_condensed(disc, *disc.global_matrices())
+
+
+def _shear_beam_condensed(disc, K, M) -> bool:
+    """Whether a shear beam's direct pencil is conditioned worse than the Euler–Bernoulli
+    beam's at :data:`CONDENSE_ABOVE` elements, the finest the direct route is given: its
+    largest scaled diagonal max K_ii/M_ii over the eigenvalue scale (EI/(ρA L⁴)) above
+    :data:`DIRECT_CONDITIONING`.  With shear deformation and rotary inertia it grows as N²,
+    not N⁴ (the rotation's mass ρI h/3 against its stiffness ~EI/h), and the groups of the
+    condensation carry more internal dynamics (400 elements of L/h 12, 10 modes: no
+    grouping passes its check), so the direct route is both the cheaper and the surer."""
+    free = disc.free
+    ratio = K.diagonal()[free] / M.diagonal()[free]
+    return float(np.max(ratio)) / disc.eigenvalue_scale > DIRECT_CONDITIONING
 
 
 def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
@@ -333,8 +361,11 @@ def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
     strain energy summed element by element (:meth:`Discretisation.strain_energy`).
     ``matrices`` may pass (K, M) already assembled (used by the direct route).
     """
-    if condensed(disc):
-        return _condensed_modes(disc, n_modes, params)
+    if disc.kind == "beam" and disc.n_elements > CONDENSE_ABOVE:
+        K, M = disc.global_matrices(params) if matrices is None else matrices
+        if disc.shear_g is None or _shear_beam_condensed(disc, K, M):
+            return _condensed_modes(disc, n_modes, params, (K, M))
+        matrices = (K, M)
     return _direct_modes(disc, n_modes, params, matrices)
 
 
@@ -389,7 +420,7 @@ def condensation_groups(n_elements: int, n_modes: int) -> int:
     return min(max(8 * n_modes, int(round(np.sqrt(np.pi * n_elements)))), n_elements // 2)
 
 
-def _condensed_modes(disc: Discretisation, n_modes: int, params) -> Modes:
+def _condensed_modes(disc: Discretisation, n_modes: int, params, matrices=None) -> Modes:
     """The condensed route (module docstring), checked: the dynamic correction may change
     no Rayleigh quotient by more than :data:`CONDENSATION_TOLERANCE` (the error left is of
     its square); otherwise the groups are halved and the solve repeated, and with no finer
@@ -400,7 +431,7 @@ def _condensed_modes(disc: Discretisation, n_modes: int, params) -> Modes:
                             f"{MAX_BEAM_ELEMENTS}, the finest mesh whose modal solve gfe-opt "
                             "verifies (the stiffness condition number grows as N⁴); a few "
                             "thousand elements resolve the first modes to 1e-9")
-    K, M = disc.global_matrices(params)
+    K, M = disc.global_matrices(params) if matrices is None else matrices
     groups = condensation_groups(n, n_modes)
     while True:
         guyan, corrected = _reduce_and_solve(disc, K, M, n_modes, groups, params)
@@ -410,7 +441,8 @@ def _condensed_modes(disc: Discretisation, n_modes: int, params) -> Modes:
         change = float(np.max(np.abs(lam_guyan[elastic] - lam[elastic]) / lam[elastic],
                               initial=0.0))
         if change <= CONDENSATION_TOLERANCE:
-            return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=corrected)
+            return Modes(frequencies_hz=np.sqrt(lam) / (2.0 * np.pi), shapes=corrected,
+                         condensed=True)
         if 2 * groups > n // 2:
             # no finer grouping left (a shear beam's groups carry more internal dynamics:
             # 400 elements, 10 modes, κGA 1.4e7 N changed an eigenvalue by 1.5e-3 on 160
