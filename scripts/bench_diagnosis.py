@@ -689,6 +689,10 @@ def main(argv=None) -> int:
                         help="with --rescore: the scorecard had each loop stopped where its "
                         "further effects explain less than each of a few shares of what "
                         "the present ones do (how selection step 10's 1 %% was chosen)")
+    parser.add_argument("--elements", type=int,
+                        help="every case's model at this many elements (the campaign's "
+                        "own: 40 to 60), e.g. 400: a fine mesh the stand-in, the condensed "
+                        "route and a shear beam's direct route are in play on")
     parser.add_argument("--sweep", action="store_true",
                         help="also print the first diagnosis under other significance "
                         "levels and size thresholds (what chose α = 1e-3 and 3 σ)")
@@ -697,6 +701,8 @@ def main(argv=None) -> int:
              else truths.campaign(args.seed, args.subset))
     if args.cases:
         cases = [c for c in cases if any(n in c.name for n in args.cases)]
+    if args.elements:
+        cases = [replace(c, model={**c.model, "elements": args.elements}) for c in cases]
     if args.rescore:
         return _rescore(args, cases)
     if args.perturb:

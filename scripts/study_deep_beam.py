@@ -1,0 +1,103 @@
+"""Deep beams on fine meshes: the modal route a shear beam takes and what its loop costs
+(``python scripts/study_deep_beam.py``).
+
+* ``route``: simply supported Timoshenko beams (κGA = 5/6 G A, rotary inertia) of L/h 12,
+  40 and 100, 6 and 10 modes, at 200 to 8 000 elements: the route
+  :func:`gfe_opt.modal.discretisation_modes` takes (``d`` direct, ``c`` condensed; stop 81:
+  a shear beam is condensed only where its pencil is conditioned worse than the
+  Euler–Bernoulli beam's at ``CONDENSE_ABOVE`` elements, ``DIRECT_CONDITIONING``), its
+  conditioning over that limit, the largest relative frequency error against the closed
+  form (``tests/reference.py``: not the package's elements) and the solve's time.
+* ``loop``: the campaign's continuum case ``--seed`` (``tests/truths.py``: a 2-D
+  plane-stress beam, scikit-fem) with its model at ``--elements``: the loop a user runs
+  (:func:`gfe_opt.diagnosis.diagnose`, then :func:`gfe_opt.diagnosis.follow`), timed, in
+  process (the fits use both cores).
+
+Measured (stop 81, this machine): see the README's Modal analysis paragraph.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from gfe_opt.assembly import discretise  # noqa: E402
+from gfe_opt.modal import DIRECT_CONDITIONING, condensed, discretisation_modes  # noqa: E402
+from gfe_opt.model import Effect  # noqa: E402
+
+
+def route(sizes) -> None:
+    from tests.conftest import make_model
+    from tests.reference import timoshenko_ss
+
+    length = 0.575
+    for slenderness in (12, 40, 100):
+        model = make_model(section={"b": 0.02, "h": length / slenderness})
+        kga = 5 / 6 * model.E / (2 * (1 + model.nu)) * model.area
+        model = model.with_effects([Effect("shear", {"shear_rigidity": kga})])
+        for n_modes in (6, 10):
+            exact = timoshenko_ss(n_modes, model.bending_rigidity, model.mass_per_length,
+                                  model.rho * model.inertia, kga, length)
+            cells = []
+            for n in sizes:
+                disc = discretise(model.with_elements(n))
+                K, M = disc.global_matrices()
+                ratio = float(np.max(K.diagonal()[disc.free] / M.diagonal()[disc.free])
+                              / disc.eigenvalue_scale / DIRECT_CONDITIONING)
+                start = time.perf_counter()
+                f = discretisation_modes(disc, n_modes).frequencies_hz
+                seconds = time.perf_counter() - start
+                cells.append(f"{n}{'c' if condensed(disc) else 'd'} {ratio:.2g} "
+                             f"{np.max(np.abs(f / exact - 1)):.1e} {seconds * 1e3:.0f}ms")
+            print(f"L/h {slenderness}, {n_modes} modes: " + " | ".join(cells), flush=True)
+
+
+def loop(seed: int, elements: int) -> None:
+    from gfe_opt.diagnosis import diagnose, follow
+    from gfe_opt.measured import make_measured
+    from gfe_opt.model import model_from_dict
+    from tests.truths import continuum_case
+
+    case = continuum_case(seed)
+    model = model_from_dict({**case.model, "elements": elements}, case.name)
+    measured = make_measured(case.x, "w", case.frequencies, case.shapes, case.name)
+    noise = ({"freq_noise": case.stated[0], "shape_noise": case.stated[1]}
+             if case.stated else {})
+    print(f"{case.name} at {elements} elements; hidden: {case.hidden}", flush=True)
+    start = time.perf_counter()
+    first = diagnose(model, measured, **noise)
+    print(f"first diagnosis {time.perf_counter() - start:.1f} s: {first.verdict}", flush=True)
+    start = time.perf_counter()
+    done = follow(model, measured, first, **noise)
+    print(f"the loop after it {time.perf_counter() - start:.1f} s: verdicts "
+          f"{done.verdicts}, added {done.added}")
+    for effect in done.model.effects:
+        print("  ", effect.name, {k: (round(v, 6) if isinstance(v, float) else v)
+                                  for k, v in effect.parameters.items()})
+    print(f"final χ²/n {done.diagnosis.current.chi2_per_residual:.3g}")
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--parts", nargs="*", default=["route", "loop"],
+                        choices=["route", "loop"])
+    parser.add_argument("--sizes", type=int, nargs="*",
+                        default=[200, 400, 1000, 2000, 4000, 8000])
+    parser.add_argument("--seed", type=int, default=3004, help="the continuum case")
+    parser.add_argument("--elements", type=int, default=400, help="the loop's model")
+    args = parser.parse_args(argv)
+    if "route" in args.parts:
+        route(args.sizes)
+    if "loop" in args.parts:
+        loop(args.seed, args.elements)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
