@@ -5,10 +5,11 @@ what double precision holds near N = 10⁵ (and shift-invert eigenvalues lose ep
 at 10⁴).  Two routes, both ending in Rayleigh quotients whose strain energy is summed
 element by element from relative deformations (no cancellation):
 
-* **direct** (bars, beams up to :data:`CONDENSE_ABOVE` elements, and longer shear beams
-  whose pencil is conditioned no worse than the Euler–Bernoulli beam's at that mesh,
-  :data:`DIRECT_CONDITIONING`: with rotary inertia the conditioning grows as N²): the
-  free-DOF matrices scaled by :math:`D = \mathrm{diag}(M)^{-1/2}`, a dense generalised solver up to
+* **direct** (bars, beams up to :data:`CONDENSE_ABOVE` elements, and shear beams up to
+  :data:`SHEAR_DIRECT_ELEMENTS` whose pencil is conditioned no worse than the
+  Euler–Bernoulli beam's at CONDENSE_ABOVE, :data:`DIRECT_CONDITIONING`: with rotary
+  inertia the conditioning grows as N²): the free-DOF matrices scaled by
+  :math:`D = \mathrm{diag}(M)^{-1/2}`, a dense generalised solver up to
   :data:`DENSE_LIMIT` DOFs, else shift-invert below the spectrum
   (:math:`σ = -λ_{ref}`, :math:`λ_{ref}` = EI/(ρA L⁴) or EA/(ρA L²): positive definite,
   free–free structures need no special case) from a fixed start vector.  Check: the
@@ -60,6 +61,15 @@ CONDENSE_ABOVE = 200
 #: 8EI/h over 8ρAh³/420: 420 N⁴).  A shear beam below it is solved directly
 #: (:func:`condensed`).
 DIRECT_CONDITIONING = 420.0 * CONDENSE_ABOVE**4
+#: The most elements a shear beam is solved directly with (:func:`condensed`): the direct
+#: route's residual grows rougher with N (Lanczos on more DOFs), the condensed one's does
+#: not, and a fit's finish feels it along a flat direction.  Measured (stop 81, χ² of the
+#: 5-mode ``ss-steel-beam`` data along κGA, the spread of its second differences over ±1e-3):
+#: direct 0.8, 1.2, 2.0, 2.4, 4.5 % at 300, 400, 600, 800, 1 000 elements, condensed
+#: 0.9–1.0 %, ``python scripts/study_deep_beam.py --parts smooth``; at 2 000 elements the
+#: direct route's shear fit took 64 evaluations where the condensed one's took 26.  (The
+#: continuum notch case of ``--parts loop`` at 300–1 000: 3.1–3.3 % either way.)
+SHEAR_DIRECT_ELEMENTS = 400
 #: Largest relative residual ‖(K − λM)φ‖ / ‖λMφ‖ a direct solve may leave.
 RESIDUAL_TOLERANCE = 1e-3
 #: Largest change of a Rayleigh quotient by the dynamic correction of the condensed shapes.
@@ -330,8 +340,8 @@ def peak_rows(shapes) -> np.ndarray:
 def condensed(model) -> bool:
     """Whether the modes of ``model`` (a Model or a Discretisation) come from the condensed
     route (:func:`_condensed_modes`): an Euler–Bernoulli beam above :data:`CONDENSE_ABOVE`
-    elements, a shear beam there only if its pencil is conditioned worse than that
-    (:func:`_shear_beam_condensed`)."""
+    elements, a shear beam there only above :data:`SHEAR_DIRECT_ELEMENTS` or if its pencil
+    is conditioned worse than that (:func:`_shear_beam_condensed`)."""
     n = model.elements if hasattr(model, "elements") else model.n_elements
     if model.kind != "beam" or n <= CONDENSE_ABOVE:
         return False
@@ -340,13 +350,17 @@ def condensed(model) -> bool:
 
 
 def _shear_beam_condensed(disc, K, M) -> bool:
-    """Whether a shear beam's direct pencil is conditioned worse than the Euler–Bernoulli
-    beam's at :data:`CONDENSE_ABOVE` elements, the finest the direct route is given: its
-    largest scaled diagonal max K_ii/M_ii over the eigenvalue scale (EI/(ρA L⁴)) above
-    :data:`DIRECT_CONDITIONING`.  With shear deformation and rotary inertia it grows as N²,
-    not N⁴ (the rotation's mass ρI h/3 against its stiffness ~EI/h), and the groups of the
-    condensation carry more internal dynamics (400 elements of L/h 12, 10 modes: no
-    grouping passes its check), so the direct route is both the cheaper and the surer."""
+    """Whether a shear beam above :data:`CONDENSE_ABOVE` elements is condensed: above
+    :data:`SHEAR_DIRECT_ELEMENTS` elements, or where its direct pencil is conditioned
+    worse than the Euler–Bernoulli beam's at CONDENSE_ABOVE elements, the finest the
+    direct route is given (its largest scaled diagonal max K_ii/M_ii over the eigenvalue
+    scale EI/(ρA L⁴) above :data:`DIRECT_CONDITIONING`).  With shear deformation and rotary
+    inertia that grows as N², not N⁴ (the rotation's mass ρI h/3 against its stiffness
+    ~EI/h), and the groups of the condensation carry more internal dynamics (400 elements
+    of L/h 12, 10 modes: no grouping passes its check), so there the direct route is both
+    the cheaper and the surer."""
+    if disc.n_elements > SHEAR_DIRECT_ELEMENTS:
+        return True
     free = disc.free
     ratio = K.diagonal()[free] / M.diagonal()[free]
     return float(np.max(ratio)) / disc.eigenvalue_scale > DIRECT_CONDITIONING

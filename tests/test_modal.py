@@ -429,11 +429,17 @@ def test_a_shear_beam_the_condensation_cannot_take_is_solved_directly():
     groups of 2 or 3 elements: the dynamic correction moves an eigenvalue by 1.7e-3; the
     groups of a shear beam carry more internal dynamics), where it raised.  Its pencil is
     conditioned 800 times better than the Euler–Bernoulli beam's at CONDENSE_ABOVE
-    elements (rotary inertia: N², not N⁴), so the route chosen is the direct one, and the
-    condensed route, forced, falls back to it: the simply supported closed form (shear and
-    rotary inertia) within 2e-4, the error falling as h² from 200 elements (observed order
-    2.0), the two routes' frequencies the same."""
-    from gfe_opt.modal import _condensed_modes, _shear_beam_condensed, condensed
+    elements (rotary inertia: N², not N⁴), so the route chosen is the direct one (up to
+    SHEAR_DIRECT_ELEMENTS: above, the direct residual grows rougher than the condensed
+    one's), and the condensed route, forced, falls back to it: the simply supported closed
+    form (shear and rotary inertia) within 2e-4, the error falling as h² from 200 elements
+    (observed order 2.0), the two routes' frequencies the same."""
+    from gfe_opt.modal import (
+        SHEAR_DIRECT_ELEMENTS,
+        _condensed_modes,
+        _shear_beam_condensed,
+        condensed,
+    )
 
     from .reference import timoshenko_ss
 
@@ -450,6 +456,7 @@ def test_a_shear_beam_the_condensation_cannot_take_is_solved_directly():
         errors.append(np.max(np.abs(f / exact - 1)))
     fine = discretise(model.with_elements(400))
     assert not condensed(fine) and not _shear_beam_condensed(fine, *fine.global_matrices())
+    assert condensed(model.with_elements(SHEAR_DIRECT_ELEMENTS + 1))
     forced = _condensed_modes(fine, 10, None).frequencies_hz
     assert np.max(np.abs(forced / f - 1)) < 1e-12
     assert errors[1] < 2e-4
