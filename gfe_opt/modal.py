@@ -373,7 +373,7 @@ def discretisation_modes(disc: Discretisation, n_modes: int, params=None,
 
     Eigenvalues are the Rayleigh quotients of the computed (mass-normalised) shapes with the
     strain energy summed element by element (:meth:`Discretisation.strain_energy`).
-    ``matrices`` may pass (K, M) already assembled (used by the direct route).
+    ``matrices`` may pass (K, M) already assembled (with ``params``), for either route.
     """
     if disc.kind == "beam" and disc.n_elements > CONDENSE_ABOVE:
         K, M = disc.global_matrices(params) if matrices is None else matrices
