@@ -301,7 +301,7 @@ def _read_journal(path: Path) -> list[dict]:
     for line in text.splitlines():
         try:
             row = json.loads(line)
-        except json.JSONDecodeError:
+        except ValueError:   # (JSONDecodeError among them)
             continue  # a line cut short by a crash: that set runs again
         if isinstance(row, dict) and "file" in row:
             rows.append(row)

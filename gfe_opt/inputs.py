@@ -7,6 +7,7 @@ Every fault is one :class:`GfeInputError` naming the file (README "Limits").
 from __future__ import annotations
 
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -43,6 +44,17 @@ def check_input_file(path, what: str) -> Path:
         raise GfeInputError(where, None, f"is {info.st_size / MiB:.1f} MB, above the "
                             f"{limit // MiB} MB limit for a {what} file")
     return path
+
+
+def parse_failure(exc: ValueError) -> str:
+    """What a JSON or TOML parser's ``ValueError`` says, in one line: its own message, or
+    for an integer longer than Python converts (``sys.get_int_max_str_digits``) that
+    number's length, not the interpreter's advice."""
+    text = str(exc)
+    found = re.search(r"value has (\d+) digits", text)
+    if found and "integer string conversion" in text:
+        return f"a number of {found.group(1)} digits"
+    return text
 
 
 def read_text(path, what: str) -> str:

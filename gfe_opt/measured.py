@@ -42,7 +42,7 @@ import scipy.sparse as sp
 
 from . import elements as el
 from .errors import GfeInputError
-from .inputs import MAX_MEASURED_MODES, MAX_SENSORS, check_input_file, read_text
+from .inputs import MAX_MEASURED_MODES, MAX_SENSORS, check_input_file, parse_failure, read_text
 from .outputs import atomic_write, check_output_path
 
 DOFS = ("w", "u")
@@ -244,6 +244,8 @@ def read_json(path, what: str = "measured"):
         raise GfeInputError(where, None, f"not valid JSON ({exc})") from None
     except RecursionError:
         raise GfeInputError(where, None, "not valid JSON (nested too deeply)") from None
+    except ValueError as exc:   # (an integer of more digits than Python converts)
+        raise GfeInputError(where, None, f"not valid JSON ({parse_failure(exc)})") from None
 
 
 def _read_json(path: Path) -> MeasuredModes:

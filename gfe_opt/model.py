@@ -161,7 +161,7 @@ def load_model(path, *, frames: bool = False) -> Model:
     A plane frame (``kind = "frame"``) is read only where ``frames`` says the caller takes
     one (a :class:`~gfe_opt.frame.FrameModel`); elsewhere it is an input error saying what
     frames can do so far."""
-    from .inputs import read_text
+    from .inputs import parse_failure, read_text
 
     where = str(path)
     text = read_text(path, "model")
@@ -171,6 +171,8 @@ def load_model(path, *, frames: bool = False) -> Model:
         raise GfeInputError(where, None, f"not valid TOML ({exc})") from None
     except RecursionError:
         raise GfeInputError(where, None, "not valid TOML (nested too deeply)") from None
+    except ValueError as exc:   # (an integer of more digits than Python converts)
+        raise GfeInputError(where, None, f"not valid TOML ({parse_failure(exc)})") from None
     if isinstance(data, dict) and data.get("kind") == "frame":
         if not frames:
             raise GfeInputError(where, "kind", "a plane frame: gfe-opt computes its modes, "
