@@ -4,8 +4,9 @@
 * ``route``: simply supported Timoshenko beams (κGA = 5/6 G A, rotary inertia) of L/h 12,
   40 and 100, 6 and 10 modes, at 200 to 8 000 elements: the route
   :func:`gfe_opt.modal.discretisation_modes` takes (``d`` direct, ``c`` condensed; stop 81:
-  a shear beam is condensed only where its pencil is conditioned worse than the
-  Euler–Bernoulli beam's at ``CONDENSE_ABOVE`` elements, ``DIRECT_CONDITIONING``), its
+  a shear beam of 201 to ``SHEAR_DIRECT_ELEMENTS`` elements is condensed only where its
+  pencil is conditioned worse than the Euler–Bernoulli beam's at ``CONDENSE_ABOVE``
+  elements, ``DIRECT_CONDITIONING``; a longer one always), its
   conditioning over that limit, the largest relative frequency error against the closed
   form (``tests/reference.py``: not the package's elements) and the solve's time.
 * ``smooth``: how rough each route leaves a fit's χ² (what chose
