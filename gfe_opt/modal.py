@@ -361,9 +361,14 @@ def _shear_beam_condensed(disc, K, M) -> bool:
     the cheaper and the surer."""
     if disc.n_elements > SHEAR_DIRECT_ELEMENTS:
         return True
+    return pencil_conditioning(disc, K, M) > DIRECT_CONDITIONING
+
+
+def pencil_conditioning(disc, K, M) -> float:
+    """The direct pencil's conditioning as :data:`DIRECT_CONDITIONING` measures it: the
+    largest scaled diagonal max K_ii/M_ii over the free DOFs, over the eigenvalue scale."""
     free = disc.free
-    ratio = K.diagonal()[free] / M.diagonal()[free]
-    return float(np.max(ratio)) / disc.eigenvalue_scale > DIRECT_CONDITIONING
+    return float(np.max(K.diagonal()[free] / M.diagonal()[free])) / disc.eigenvalue_scale
 
 
 def discretisation_modes(disc: Discretisation, n_modes: int, params=None,

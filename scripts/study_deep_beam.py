@@ -35,7 +35,12 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from gfe_opt.assembly import discretise  # noqa: E402
-from gfe_opt.modal import DIRECT_CONDITIONING, condensed, discretisation_modes  # noqa: E402
+from gfe_opt.modal import (  # noqa: E402
+    DIRECT_CONDITIONING,
+    condensed,
+    discretisation_modes,
+    pencil_conditioning,
+)
 from gfe_opt.model import Effect  # noqa: E402
 
 
@@ -55,8 +60,7 @@ def route(sizes) -> None:
             for n in sizes:
                 disc = discretise(model.with_elements(n))
                 K, M = disc.global_matrices()
-                ratio = float(np.max(K.diagonal()[disc.free] / M.diagonal()[disc.free])
-                              / disc.eigenvalue_scale / DIRECT_CONDITIONING)
+                ratio = pencil_conditioning(disc, K, M) / DIRECT_CONDITIONING
                 start = time.perf_counter()
                 f = discretisation_modes(disc, n_modes).frequencies_hz
                 seconds = time.perf_counter() - start

@@ -235,9 +235,9 @@ def test_shear_on_a_beam_the_condensation_cannot_take_is_fitted():
     assert abs(fit.effects[0].parameters["shear_rigidity"] / kga - 1) < 0.01
 
 
-def _deep_beam_data(elements, n_modes=6, seed=4):
+def _deep_beam_data(elements):
     """A deep beam (L/h = 12) of ``elements`` and its measurement from the Timoshenko
-    closed form (30 sensors, noise): not the model being fitted."""
+    closed form (six modes, 30 sensors, noise): not the model being fitted."""
     from gfe_opt.measured import make_measured
 
     from .conftest import make_model
@@ -247,10 +247,10 @@ def _deep_beam_data(elements, n_modes=6, seed=4):
     model = make_model(section={"b": 0.02, "h": length / 12}, elements=elements)
     kga = 5 / 6 * model.E / (2 * (1 + model.nu)) * model.area
     s = interior(length, 30)
-    f = timoshenko_ss(n_modes, model.bending_rigidity, model.mass_per_length,
+    f = timoshenko_ss(6, model.bending_rigidity, model.mass_per_length,
                       model.rho * model.inertia, kga, length)
-    f, y = add_noise(f, np.sin(np.outer(s, np.arange(1, n_modes + 1) * np.pi / length)),
-                     seed=seed, shape_noise=0.003, freq_noise=0.0005)
+    f, y = add_noise(f, np.sin(np.outer(s, np.arange(1, 7) * np.pi / length)), seed=4,
+                     shape_noise=0.003, freq_noise=0.0005)
     return model, make_measured(s, "w", f, y, "timoshenko"), kga
 
 
