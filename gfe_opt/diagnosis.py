@@ -326,6 +326,11 @@ class Diagnosis:
     #: the candidates fitted again from every valley of their grids before the verdict
     #: (:func:`_again_thorough`): a beam's suggestion names their place (``add_arguments``)
     thorough: tuple = ()
+    #: the suggestions fitted alone from where an explaining pair put them, its first
+    #: standing for nothing (:func:`_second_alone`): their own fit from the grid ends in
+    #: another valley, so the suggestion gives every fitted value as update's start
+    #: (``add_arguments``)
+    from_pair: tuple = ()
 
     @property
     def best(self) -> Fit | None:
@@ -341,6 +346,12 @@ class Diagnosis:
         if not self.suggested or fit is None:
             return list(self.suggested)
         added = fit.effects[len(fit.effects) - len(self.suggested):]
+        if self.from_pair:
+            # found from a pair's end: every fitted value starts update's fit (a start,
+            # still fitted), which the grid's best does not lead to (:func:`_second_alone`)
+            return [e.name + ":" + ",".join(f"{k}={v}" for k, v in e.parameters.items()
+                                            if not isinstance(v, (list, tuple)))
+                    if e.name in self.from_pair else e.name for e in added]
         if not structure(fit.model).discrete_places:
             # found from another valley than the grid's best (``thorough``): the place it
             # was found at starts update's fit (a start, still fitted), so that update
@@ -1069,7 +1080,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
         return looks_like_noise(model, fit.misfit, correlation, measured)
 
     partial = together = None
-    suggested, offered = [], []
+    suggested, offered, from_pair = [], [], []
     # a free profile may explain significantly more whenever the best does not bring χ² to
     # the noise (stated or assumed): residuals that look white with no noise given do not
     # rule it out (a quadratic taper read as one long zone, the rest then chased by more)
@@ -1095,6 +1106,19 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
             # continuum).  A pair that merely ties with a profile far from the noise is
             # one more way to absorb model error, not the structure's difference
             rivalled = profile is not None and any(sel.better(p, profile) for p in tried)
+            alone = None if pair is None else _second_alone(model, measured, noise, C, pair,
+                                                            fits, explains, sel)
+            if alone is not None:
+                # the pair's first stands for nothing: its second alone, from the pair's
+                # end, explains at a lower information criterion (the candidate's own fit
+                # had not reached that valley) and is the finding
+                fits[next(i for i, f in enumerate(fits) if f.name == alone.name)] = alone
+                sel.floor = _floor([*fits, reference])
+                _judge(fits, sel, material, model)
+                from_pair.append((alone, pair.effects[pair.added - 1].name))
+                best, first, pair, rivalled = _best(fits, sel), alone, None, False
+                if profile is not None:
+                    profile.significant = False  # named effects win where they explain
             if pair is not None and profile is not None and profile.success \
                     and not profile.failed and sel.better(profile, pair):
                 pair = None   # a free profile explains significantly more than the pair
@@ -1321,6 +1345,14 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
                      f"(to take it out: gfe-opt update MODEL MEASURED --drop {d['index']})")
     if skipped:
         notes.append(_skipped_note(skipped, measured, model))
+    from_pair = tuple((f, lead) for f, lead in from_pair if verdict == "effect_found"
+                      and together is None and ranked and ranked[0] is f
+                      and suggested == [f.name])
+    for f, lead in from_pair:
+        notes.append(f"{f.name} was found beside a {lead} that then stood for nothing: "
+                     f"fitted alone from where that pair put it, it explains as much with "
+                     f"fewer parameters; its fit from its own starts ends elsewhere, so "
+                     f"the update command gives it these values to start from")
     return Diagnosis(baseline=baseline, reference=reference, fits=ranked, failed=failed,
                      skipped=skipped, verdict=verdict, noise=estimate, alike=alike,
                      suggested=suggested if verdict == "effect_found" else [],
@@ -1331,7 +1363,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
                      notes=notes, remaining=remaining,
                      offered=offered if verdict == "unexplained" else [],
                      replace=replace, not_needed=not_needed, withheld=withheld,
-                     moved=moved)
+                     moved=moved, from_pair=tuple(f.name for f, _ in from_pair))
 
 
 def _known_moved(model, reference) -> list[dict]:
@@ -1707,6 +1739,30 @@ def _lookahead(model, measured, noise, best, fits, hint, explains, sel):
                 first.significant = first.leads_pair = True
             return first, second, tried
     return best, None, tried
+
+
+def _second_alone(model, measured, noise, C, pair, fits, explains, sel):
+    """The explaining ``pair``'s second effect fitted alone, started where the pair put it;
+    it replaces that candidate's own fit when it explains the data too, at an information
+    criterion (:meth:`_Selection.penalised`) no higher than the pair's, and with a lower χ²
+    than the candidate's own fit (whose starts had missed that valley).  The pair's first
+    then stands for nothing: a uniform E that ends at the model's beside a zone stiffer than
+    the rest, which the zone's own fit, started from losses, did not find (a free-free
+    roving-hammer test, stop 82).  None otherwise."""
+    own = next((f for f in fits if f.name == pair.name), None)
+    if pair.added is None or own is None:
+        return None
+    try:
+        alone = fit_effects(model, measured, [Effect(pair.name, dict(pair.parameters))],
+                            noise=noise, C=C, name=pair.name)
+    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+        return None
+    if not alone.success or alone.unidentified or not explains(alone) \
+            or sel.penalised(alone) > sel.penalised(pair) \
+            or alone.misfit.chi2 >= own.misfit.chi2:
+        return None
+    alone.other_places = own.other_places
+    return alone
 
 
 def _may_lead(fit, model) -> bool:

@@ -1376,6 +1376,22 @@ def _saturated(sides) -> list:
              if side is not None and v.log and v.index is None} for slot in sides]
 
 
+def _vanished(slot, marks) -> str | None:
+    """The key of ``slot``'s variable held on the bound of its range where its effect
+    vanishes (``marks``: the slot's :func:`_saturated` entry; a point spring's stiffness
+    at its lower end, whose :attr:`~gfe_opt.effects.base.Parameter.null` is 0; a shear
+    rigidity at its upper end, null ∞), or None."""
+    for v in slot.variables:
+        side = marks.get(v.key)
+        if side is None or v.index is not None:
+            continue
+        null = slot.effect.parameter(v.key).null
+        if (side == "at most" and isinstance(null, float) and null == 0.0) or (
+                side == "at least" and null == "inf"):
+            return v.key
+    return None
+
+
 def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=None):
     """Standard deviations of every slot's physical parameters (Gauss–Newton), and the
     parameters the data do not estimate (sentences: σ above the value, or a correlation
@@ -1427,11 +1443,22 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     sizes = {}  # variable -> (its physical value, d value / d variable)
     i = 0
     for j, slot in enumerate(slots):
+        gone = _vanished(slot, (saturated or [{}] * len(slots))[j])
         for v in slot.variables:
             phys = v.physical(base, z[i])
             derivative = phys * np.log(10.0) if v.log else v.scale(base)
             sizes[i] = (phys, derivative)
             value = abs(derivative) * sd_z[i]
+            if gone is not None and v.key != gone and not held[i]:
+                # the effect is at the end of its range where it does nothing: where it
+                # sits (or how long it is) the data cannot tell, whatever the curvature
+                # of χ² along it (a point spring's position read ± 1e14 m)
+                value = np.inf
+                if slot.added:
+                    unidentified.append(
+                        f"{slot.effect.name}.{v.key}: not determined: "
+                        f"{slot.effect.name}.{gone} is at the end of its range where the "
+                        f"{slot.effect.name} vanishes")
             if v.index is None:
                 out[j][v.key] = float(value)
             else:

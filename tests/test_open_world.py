@@ -174,6 +174,70 @@ def test_a_mid_span_spring_is_a_point_spring_not_a_foundation():
     assert abs(spring["position"] - L / 2) <= 0.015 and abs(spring["stiffness"] / 2e5 - 1) < 0.1
 
 
+def test_a_zone_stiffer_than_the_rest_is_found_alone_not_beside_a_uniform_change():
+    """A free-free aluminium beam (0.8 m, 21 sensors from end to end, 5 elastic modes) with
+    a bonded doubler: EI 1.4 and ρA 1.15 times over 0.45-0.65 m, from the independent
+    reference beam.  The section loss's own fit (started from losses) ends in another
+    valley, the uniform E fits best alone, and E with a section loss explains the data to
+    the noise, E ending at the model's own.  Before stop 82 the diagnosis suggested both
+    (on other seeds an axial load of 0.2 N with the zone): the second effect alone, fitted
+    from where the pair put it, explains as well with a lower information criterion, and
+    is now the finding; update started there (the suggestion's values) ends there too, and
+    after it the model is consistent."""
+    length = 0.8
+    model = make_model(name="ff-al", length=length, elements=40,
+                       material={"E": 70e9, "rho": 2700.0, "nu": 0.33},
+                       section={"b": 0.02, "h": 0.008},
+                       supports={"left": "free", "right": "free"})
+    beam = ReferenceBeam(length=length, EI=70e9 * 0.02 * 0.008**3 / 12,
+                         rho_a=2700 * 0.02 * 0.008, supports=("free", "free"), elements=800,
+                         rigidity=zone(0.55, 0.2, 1.4), mass=zone(0.55, 0.2, 1.15))
+    x = np.linspace(0.0, length, 21)
+    f, y = beam.measure(7, x, seed=5, shape_noise=0.001, freq_noise=0.0001)
+    measured = make_measured(x, "w", f[2:], y[:, 2:], "doubler")
+    d = diagnose(model, measured, **NOISE)
+    assert d.verdict == "effect_found" and d.suggested == ["section_loss"], d.suggested
+    assert d.together is None
+    zone_fit = d.best.parameters
+    assert abs(zone_fit["position"] - 0.55) <= 0.02 * length
+    assert abs(zone_fit["length"] / 0.2 - 1) < 0.1
+    assert abs(zone_fit["stiffness_ratio"] / 1.4 - 1) < 0.05
+    assert abs(zone_fit["mass_ratio"] / 1.15 - 1) < 0.05
+    # its own fit from the grid ends elsewhere: the suggestion starts update at the finding
+    add = d.add_arguments()
+    assert d.from_pair == ("section_loss",) and add[0].startswith("section_loss:position=")
+    assert d.to_json()["add"] == add
+    assert any(n.startswith("section_loss was found beside a material that then stood for "
+                            "nothing") for n in d.notes)
+    after = update(model, measured, add, **NOISE)
+    assert after.fit.parameters == pytest.approx(zone_fit, rel=1e-4)
+    assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
+
+
+def test_a_spring_the_data_do_not_want_has_no_place():
+    """A point spring added to a beam whose data hold none (the reference beam with a
+    crack; a spring of negative stiffness would help, none of positive) ends at the soft end
+    of its range, where it does nothing: its position is then not determined by the data.
+    Before, the σ of the position came from the curvature of χ² along it with the spring
+    held at that end, ± 1e14 m, and the text rounded the position to its σ (0.575 m printed
+    as 1).  Beside it, a real spring keeps a σ of its position well inside the beam."""
+    measured = reference_data(rigidity=christides_barr(0.19, 0.5))
+    fit = update(make_model(), measured, ["point_spring"], **NOISE).fit
+    assert fit.bound == {"stiffness": "at most"}
+    assert np.isinf(fit.uncertainty["position"])
+    assert fit.to_json()["uncertainty"]["position"] is None
+    assert f"position = {fit.parameters['position']:.4g} m (not determined by the data)" \
+        in fit.describe()
+    assert fit.unidentified == ["point_spring.position: not determined: "
+                                "point_spring.stiffness is at the end of its range where "
+                                "the point_spring vanishes"]
+    real = update(make_model(), reference_data(point_springs=[(L / 2, 2e5)]),
+                  ["point_spring"], **NOISE).fit
+    assert real.bound == {} and not real.unidentified
+    assert abs(real.parameters["position"] - L / 2) <= 3 * real.uncertainty["position"] \
+        + 0.005 * L and real.uncertainty["position"] < 0.01 * L
+
+
 def test_a_roller_partway_along_is_a_stiff_point_spring_at_its_place():
     """An intermediate support that holds the beam still (a spring 10⁴ times stiffer than the
     fifth mode's modal stiffness): the start grid spans flexible to rigid springs, so the
