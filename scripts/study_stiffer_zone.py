@@ -16,8 +16,8 @@ Measured (stop 82; each side run from its own checkout, one BLAS thread):
 further effect that stood for nothing (material twice, an axial load, a support spring on
 a free end twice); now 24.  Held out, ``--seed 7300 --cases 24`` and ``--seed 7400
 --cases 48``: 71 of 72 before (one with material), 72 now.  With the noise as stated
-(``--data-noise 0.003,0.0005 --seed 7100``, and ``--supports mixed --seed 7000`` with that noise): 24 of 24
-both before and after.
+(``--data-noise 0.003,0.0005 --seed 7100``, and ``--supports mixed --seed 7000`` with that
+noise): 24 of 24 both before and after.
 """
 
 from __future__ import annotations
