@@ -1113,6 +1113,8 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
                 # end, explains at a lower information criterion (the candidate's own fit
                 # had not reached that valley) and is the finding
                 fits[next(i for i, f in enumerate(fits) if f.name == alone.name)] = alone
+                if effect_type(alone.name).uniform_reference:
+                    material = alone   # (what the others must beat: its fit now)
                 sel.floor = _floor([*fits, reference])
                 _judge(fits, sel, material, model)
                 from_pair.append((alone, pair.effects[pair.added - 1].name))
