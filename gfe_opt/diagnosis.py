@@ -1351,10 +1351,10 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
                       and together is None and ranked and ranked[0] is f
                       and suggested == [f.name])
     for f, lead in from_pair:
-        notes.append(f"{f.name} was found beside a {lead} that then stood for nothing: "
-                     f"fitted alone from where that pair put it, it explains as much with "
-                     f"fewer parameters; its fit from its own starts ends elsewhere, so "
-                     f"the update command gives it these values to start from")
+        notes.append(f"{f.name} was found in a pair with {lead}, which then stood for "
+                     f"nothing: fitted alone from where that pair put it, it explains as "
+                     f"much with fewer parameters; its fit from its own starts ends "
+                     f"elsewhere, so the update command gives it these values to start from")
     return Diagnosis(baseline=baseline, reference=reference, fits=ranked, failed=failed,
                      skipped=skipped, verdict=verdict, noise=estimate, alike=alike,
                      suggested=suggested if verdict == "effect_found" else [],

@@ -1401,9 +1401,9 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     out = [{} for _ in slots]
     if n == 0 or not np.isfinite(fit_misfit.chi2):
         return out, [], [], [{} for _ in slots]
-    held = np.array([v.key in marks for marks, slot in zip(saturated or [{}] * len(slots),
-                                                             slots) for v in slot.variables],
-                    dtype=bool)
+    saturated = saturated or [{}] * len(slots)
+    held = np.array([v.key in marks for marks, slot in zip(saturated, slots)
+                     for v in slot.variables], dtype=bool)
     r0 = residual(z)
     T, tied_names, tied_owner = _ties(slots, base, z)
     if T is None:
@@ -1443,7 +1443,7 @@ def _uncertainty(residual, z, slots, base, fit_misfit, lower, upper, saturated=N
     sizes = {}  # variable -> (its physical value, d value / d variable)
     i = 0
     for j, slot in enumerate(slots):
-        gone = _vanished(slot, (saturated or [{}] * len(slots))[j])
+        gone = _vanished(slot, saturated[j])
         for v in slot.variables:
             phys = v.physical(base, z[i])
             derivative = phys * np.log(10.0) if v.log else v.scale(base)

@@ -207,8 +207,8 @@ def test_a_zone_stiffer_than_the_rest_is_found_alone_not_beside_a_uniform_change
     add = d.add_arguments()
     assert d.from_pair == ("section_loss",) and add[0].startswith("section_loss:position=")
     assert d.to_json()["add"] == add
-    assert any(n.startswith("section_loss was found beside a material that then stood for "
-                            "nothing") for n in d.notes)
+    assert any(n.startswith("section_loss was found in a pair with material, which then "
+                            "stood for nothing") for n in d.notes)
     after = update(model, measured, add, **NOISE)
     assert after.fit.parameters == pytest.approx(zone_fit, rel=1e-4)
     assert diagnose(after.model, measured, **NOISE).verdict == "consistent"
