@@ -272,6 +272,7 @@ class Builder:
     element_terms: list = field(default_factory=list)
     point_stiffness: list = field(default_factory=list)
     point_masses: list = field(default_factory=list)
+    point_inertias: list = field(default_factory=list)
     end_springs: list = field(default_factory=list)
 
     # -- what effects call --------------------------------------------------------------
@@ -295,6 +296,11 @@ class Builder:
     def add_point_mass(self, x: float, m: float) -> None:
         """A mass m [kg] at x [m] (translation only)."""
         self.point_masses.append((float(x), float(m)))
+
+    def add_point_inertia(self, x: float, J: float) -> None:
+        """A rotary inertia J [kg m²] at x [m] (a beam: the kinetic energy J θ̇²/2 of a body
+        that turns with the beam's slope there)."""
+        self.point_inertias.append((float(x), float(J)))
 
     def add_end_spring(self, side: str, k: float, translation: bool = False) -> None:
         """A spring at the ``"left"`` or ``"right"`` end: rotational k [N m/rad], or with
@@ -360,7 +366,8 @@ class Builder:
             if f.support is None:
                 return None
             out.append(np.arange(*_support_range(f.support, L, n)))
-        out += [[self._shape_at(x)[0]] for x, _ in (*self.point_stiffness, *self.point_masses)]
+        out += [[self._shape_at(x)[0]] for x, _ in (*self.point_stiffness, *self.point_masses,
+                                                     *self.point_inertias)]
         return np.unique(np.concatenate(out)).astype(int) if out else np.zeros(0, dtype=int)
 
     def _extra(self, only=None) -> np.ndarray:
@@ -389,6 +396,13 @@ class Builder:
         if self.model.kind == "beam":
             return e, el.hermite(xi) * el.beam_dof_scaling(L)
         return e, el.linear(xi)
+
+    def _slope_at(self, x):
+        """Element index and the slope's shape functions (physical DOFs) at position x of a
+        beam: at a node, its rotation DOF alone."""
+        n, L = self.model.elements, self.model.element_length
+        e = min(int(x // L), n - 1)
+        return e, el.hermite_d1(x / L - e) * el.beam_dof_scaling(L) / L
 
     def _stiffness(self, rigidity: float, only=None) -> dict:
         """Generic stiffness parameters per element (``only``: of those elements) and the
@@ -434,6 +448,10 @@ class Builder:
             e, shape_at = self._shape_at(x)
             if place[e] >= 0:
                 mass[place[e]] += m * np.outer(shape_at, shape_at)
+        for x, J in self.point_inertias:
+            e, slope = self._slope_at(x)
+            if place[e] >= 0:
+                mass[place[e]] += J * np.outer(slope, slope)
         return mass
 
 

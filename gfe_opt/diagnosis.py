@@ -456,7 +456,7 @@ def check_enough_modes(measured: MeasuredModes, effects) -> None:
 
 def _candidates(model: Model, candidates) -> list[str]:
     if candidates is None:
-        return list(candidate_names(model.kind))
+        return [n for n in candidate_names(model.kind) if effect_type(n).candidate_for(model)]
     out = []
     for name in candidates:
         kind = effect_type(name, "--candidates", None)

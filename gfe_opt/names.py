@@ -7,7 +7,7 @@ imported here, so ``gfe-opt --version``, ``--help`` and usage errors start in a 
 BUILTIN_EFFECTS = ("material", "crack", "section_loss", "shear", "axial_load", "foundation",
                    "support_spring", "support_translation", "point_spring", "point_mass",
                    "stiffness_profile", "mass_profile", "joint_spring", "axial_stiffness",
-                   "member_shear")
+                   "member_shear", "rotary_inertia", "attached_body")
 #: lowest MAC of a pair in ``compare``
 DEFAULT_MAC_THRESHOLD = 0.6
 #: shape noise that regularises the expansion in ``compare``

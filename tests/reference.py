@@ -3,10 +3,11 @@
 It shares no code with ``gfe_opt``: its own cubic Hermite elements on a fine uniform mesh,
 element matrices integrated with Gauss points from arbitrary EI(x) and ρA(x) functions (the
 package builds cracks with exact-flexibility elements and uniform sections with closed-form
-matrices), point masses and translational springs interpolated with the shape functions,
-geometric stiffness for an axial force, a Winkler foundation, rotational end springs and
-the four classic supports.  Measurements come out as plain arrays, with Gaussian noise
-relative to each mode's largest amplitude (shapes) and to each frequency.
+matrices), point masses and translational springs interpolated with the shape functions
+(a body's rotary inertia with their slopes), geometric stiffness for an axial force, a
+Winkler foundation, rotational end springs and the four classic supports.  Measurements
+come out as plain arrays, with Gaussian noise relative to each mode's largest amplitude
+(shapes) and to each frequency.
 
 Also the Timoshenko closed form of a simply supported beam (Blevins; REFERENCES.md).
 """
@@ -50,6 +51,8 @@ class ReferenceBeam:
     foundation: float = 0.0
     point_masses: list = field(default_factory=list)     # (x, kg)
     point_springs: list = field(default_factory=list)    # (x, N/m)
+    point_inertias: list = field(default_factory=list)   # (x, kg m²): a body's rotary
+    #                                                      inertia, on the slope there
     end_springs: dict = field(default_factory=dict)      # "left"/"right" -> N m/rad
     hinges: list = field(default_factory=list)           # (x, N m/rad): a rotational spring
     #                                                      between the two sides of a node
@@ -98,6 +101,13 @@ class ReferenceBeam:
             for a in range(4):
                 for b in range(4):
                     target[idx[a], idx[b]] += value * shape[a] * shape[b]
+        for xp, J in self.point_inertias:
+            e = min(int(xp / h), n - 1)
+            slope = _hermite(np.array(xp / h - e), h)[1]
+            idx = dofs[e]
+            for a in range(4):
+                for b in range(4):
+                    M[idx[a], idx[b]] += J * slope[a] * slope[b]
         for side, k in self.end_springs.items():
             dof = 1 if side == "left" else 2 * n + 1
             K[dof, dof] += k

@@ -71,6 +71,7 @@ def candidate_names(kind: str) -> tuple:
 
 def _register_builtins():
     from . import (
+        attached_body,
         axial_load,
         axial_stiffness,
         crack,
@@ -81,6 +82,7 @@ def _register_builtins():
         member_shear,
         point_mass,
         point_spring,
+        rotary_inertia,
         section_loss,
         shear,
         stiffness_profile,
@@ -91,7 +93,7 @@ def _register_builtins():
     for module in (material, crack, section_loss, shear, axial_load, foundation,
                    support_spring, support_translation, point_spring, point_mass,
                    stiffness_profile, mass_profile, joint_spring, axial_stiffness,
-                   member_shear):
+                   member_shear, rotary_inertia, attached_body):
         register_effect(module.EFFECT)
 
 

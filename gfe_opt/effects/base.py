@@ -295,6 +295,12 @@ class EffectType:
         """The frame's place parameters, then the others (what :meth:`describe` prints)."""
         return (*self.frame_parameters, *self.parameters)
 
+    def candidate_for(self, model) -> bool:
+        """Whether ``diagnose`` tries it on ``model`` by default (with :attr:`candidate`;
+        an effect that only completes another, the rotary inertia of an attached mass,
+        asks for that one in the model)."""
+        return True
+
     def is_local(self, model) -> bool:
         """Whether the effect may appear more than once in ``model`` (:attr:`local`; an
         effect global on a beam may be one a member on a frame)."""
