@@ -44,7 +44,6 @@ def case(seed: int, k: int, data_noise) -> dict:
     sup = SUPPORTS[k % 4]
     L = STEEL["length"]
     rho_a = STEEL["rho"] * STEEL["b"] * STEEL["h"]
-    EI = STEEL["E"] * STEEL["b"] * STEEL["h"] ** 3 / 12
     free_ends = [x for x, s in ((0.0, sup[0]), (L, sup[1])) if s == "free"]
     x0 = (float(rng.choice(free_ends)) if free_ends and rng.integers(2)
           else float(rng.uniform(0.15, 0.85) * L))
