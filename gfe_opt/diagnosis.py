@@ -884,15 +884,17 @@ def _judge(fits, sel: _Selection, material: Fit | None, model: Model) -> None:
         kind = effect_type(f.name)
         f.gain = sel.reference_chi2 - f.misfit.chi2
         f.size_sigmas = kind.size_in_sigmas(base, f.parameters, f.uncertainty)
-        if any(kind.parameter(k).null is not None for k in f.bound) or kind.told_trades(base) \
-                or f.traded:
+        if any(kind.parameter(k).null is not None and k not in kind.present_at_null
+               for k in f.bound) or kind.told_trades(base) or f.traded:
             # a parameter on a bound of its range has no σ to measure a distance with, nor
             # an effect whose parameters trade as it allows (a zone on a frame: "no effect"
             # is a whole line, ratio 1 at any length or length 0 at any ratio, and each σ
             # spans the trade: a 2 cm zone fitting 30 times the floor better was 2.99 σ
             # from nothing): the distance from "no effect" is the likelihood ratio's,
             # √(gain / floor) (what |value − null|/σ is for a linear model); so is one whose
-            # size trades with another instance's (on a frame, told: :attr:`Fit.traded`)
+            # size trades with another instance's (on a frame, told: :attr:`Fit.traded`).  A
+            # parameter at whose null the effect is still there (a body's J) is not its
+            # size: at that bound the effect is the simpler one (a point mass), size 0
             f.size_sigmas = float(np.sqrt(max(f.gain, 0.0) / sel.floor))
         f.threshold = sel.threshold(f)
         # what it explains alone exceeds its threshold, whatever its size's σ (one loose
@@ -1562,7 +1564,7 @@ def _swap(model, measured, noise, reference, names, sel):
         closest = None
         for alt in _run_jobs(jobs, None, [f"{a} in place of {effect.name}" for a in alts]) \
                 if jobs else []:
-            if not alt.success or alt.unidentified:
+            if not alt.success or alt.unidentified or _as_simpler(alt, base):
                 continue
             if closest is None or sel.penalised(alt) < sel.penalised(closest):
                 closest = alt
@@ -1759,12 +1761,25 @@ def _second_alone(model, measured, noise, C, pair, fits, explains, sel):
                             noise=noise, C=C, name=pair.name)
     except (GfeSolverError, ValueError, np.linalg.LinAlgError):
         return None
-    if not alone.success or alone.unidentified or not explains(alone) \
+    if not alone.success or alone.unidentified or _as_simpler(alone, model) \
+            or not explains(alone) \
             or sel.penalised(alone) > sel.penalised(pair) \
             or alone.misfit.chi2 >= own.misfit.chi2:
         return None
     alone.other_places = own.other_places
     return alone
+
+
+def _as_simpler(fit, model) -> bool:
+    """Whether ``fit``'s effect is, by these data, the simpler kind it extends
+    (:attr:`~gfe_opt.effects.base.EffectType.simpler`: a body whose J lies within
+    :data:`SIZE_SIGMAS` σ of 0 is the point mass): then it is not offered where the
+    information criterion alone ranks fits (a pair's second, the kind in a present effect's
+    place), as it is no finding among the candidates (the held-out continuum block 2769: a
+    lumped mass read as a body of J 2.7 σ from 0 named in the point mass's place)."""
+    kind = effect_type(fit.name)
+    return kind.simpler is not None and kind.size_in_sigmas(
+        model, fit.parameters, fit.uncertainty) < SIZE_SIGMAS
 
 
 def _may_lead(fit, model) -> bool:
@@ -1792,7 +1807,7 @@ def _simplest_first(model, measured, noise, hint, explains, sel, first, pair, ot
     best = (first, pair)
     labels = [f"{f.name} + {f.name if repeat else pair.name}" for f in others]
     for f, alt in zip(others, _run_jobs(jobs, None, labels)):
-        if not alt.success or alt.unidentified:
+        if not alt.success or alt.unidentified or _as_simpler(alt, model):
             continue
         if sel.better(alt, f):
             tried.append(alt)
@@ -1816,7 +1831,7 @@ def _pairs_with(model, measured, noise, best, fits, hint, explains, sel):
                            [alone[name]] if name in alone else []))
             for name in seconds]
     pairs = [p for p in _run_jobs(jobs, None, [f"{best.name} + {name}" for name in seconds])
-             if p.success and not p.unidentified]
+             if p.success and not p.unidentified and not _as_simpler(p, model)]
     explaining = [p for p in pairs if explains(p)]
     return (_rank(explaining, sel)[0] if explaining else None), pairs
 

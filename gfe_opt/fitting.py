@@ -1383,7 +1383,7 @@ def _vanished(slot, marks) -> str | None:
     rigidity at its upper end, null ∞), or None."""
     for v in slot.variables:
         side = marks.get(v.key)
-        if side is None or v.index is not None:
+        if side is None or v.index is not None or v.key in slot.effect.present_at_null:
             continue
         null = slot.effect.parameter(v.key).null
         if (side == "at most" and isinstance(null, float) and null == 0.0) or (

@@ -23,6 +23,8 @@ class AttachedBody(EffectType):
                  "a moment J ẅ′ there)")
     kinds = ("beam",)
     local = True
+    present_at_null = ("inertia",)
+    simpler = "point_mass"
     parameters = (
         Parameter("position", "m", "position", "where the body is attached"),
         Parameter("mass", "kg", "positive", "the body's mass", null=0.0),
@@ -31,8 +33,10 @@ class AttachedBody(EffectType):
     )
 
     def check(self, model, params, where, prefix):
-        check_not_on_support(model, params, where, prefix, "attached body",
-                             FIXED_TRANSLATION, "the support holds the structure still")
+        # on a pinned end the body's J still acts, its mass not: that is a rotary_inertia
+        check_not_on_support(model, params, where, prefix, "body's mass", FIXED_TRANSLATION,
+                             "the support holds the translation still (for the body's "
+                             "rotary inertia alone: rotary_inertia)")
 
     def contribute(self, model, params, build):
         build.add_point_mass(params["position"], params["mass"])

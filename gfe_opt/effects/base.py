@@ -281,6 +281,14 @@ class EffectType:
     uniform_reference: bool = False
     #: effects whose presence holds this one (E and a stiffness profile are one parameter)
     redundant_with: tuple = ()
+    #: parameters at whose null the effect is still there (a body's rotary inertia: it is
+    #: then a point mass), unlike a size at its null, where the effect vanishes and its
+    #: place is not determined by the data
+    present_at_null: tuple = ()
+    #: the kind this one extends, which it is where its own size (:meth:`size_in_sigmas`)
+    #: lies within the significance's σ of nothing (a body whose J the data do not tell is
+    #: the point mass): not offered in place of another effect nor as a pair's second then
+    simpler: str | None = None
     #: on a plane frame (``"frame"`` in :attr:`kinds`): the parameters that place the effect
     #: (a member, a node, a direction; chosen, not fitted), in place of a beam's ``side``
     frame_parameters: tuple = ()
