@@ -68,8 +68,11 @@ class AttachedBody(EffectType):
         x = params["position"]
         ax.plot([x], [y], marker="s", color="tab:purple", ms=8, zorder=5)
         ax.plot([x], [y], marker="$\\circlearrowright$", color="tab:purple", ms=16, zorder=5)
+        # the label runs inwards from an end (centred, a tip body's was cut off)
+        side = x / model.length
+        ha = "right" if side > 0.7 else "left" if side < 0.3 else "center"
         ax.annotate(f"{1000 * params['mass']:.3g} g, J {params['inertia']:.3g} kg m²",
-                    (x, y), textcoords="offset points", xytext=(0, 9), ha="center",
+                    (x, y), textcoords="offset points", xytext=(0, 10), ha=ha,
                     fontsize=7, color="tab:purple")
 
 

@@ -58,8 +58,10 @@ class RotaryInertia(EffectType):
     def mark(self, ax, model, params, sigma, y, bounds=None):
         x = params["position"]
         ax.plot([x], [y], marker="$\\circlearrowright$", color="tab:purple", ms=11, zorder=5)
+        side = x / model.length
+        ha = "right" if side > 0.7 else "left" if side < 0.3 else "center"
         ax.annotate(f"J {params['inertia']:.3g} kg m²", (x, y), textcoords="offset points",
-                    xytext=(0, -14), ha="center", fontsize=7, color="tab:purple")
+                    xytext=(0, -14), ha=ha, fontsize=7, color="tab:purple")
 
 
 EFFECT = RotaryInertia()
