@@ -1336,6 +1336,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
         if realise:
             notes.append("the generic-element update needs mode shapes: not run")
     notes += _noise_notes(estimate, verdict, measured)
+    notes += _mesh_notes(model, measured, estimate, verdict)
     # backward elimination judges the effects that are to stay: with an effect missing they
     # are re-estimated without it (a known crack read as nothing beside a missing prop was
     # "not needed"); the next diagnosis, after the addition, judges them
@@ -2352,6 +2353,62 @@ def _noise_notes(est: NoiseEstimate, verdict: str, measured) -> list[str]:
                          f"diagnose again with --shape-noise {est.implied_shape:.2g} "
                          f"--freq-noise {est.implied_freq:.2g}")
     return notes
+
+
+#: a present effect acting as a moment inside an element is worth a note when the model
+#: at twice the elements moves a frequency by more than this many times the frequency noise
+MESH_NOTE_NOISE = 3.0
+#: a node this close to a place (in elements) reads a moment there as if on it (the
+#: tip-body study's case 8117 at 70 and 79 elements, its body 3 % and 2 % of an element
+#: from a node: consistent, J within 0.8 %; at 46, half an element away, 0.38 % off)
+NODE_NEAR = 0.05
+
+
+def _mesh_notes(model, measured, est: NoiseEstimate, verdict: str) -> list[str]:
+    """Where a difference remains and the model holds an effect that acts as a moment at a
+    point inside an element (:attr:`~gfe_opt.effects.base.EffectType.point_moment`: a
+    body's rotary inertia, whose moment makes the curvature jump there, which the element's
+    cubic cannot follow), the model at twice the elements says how far its frequencies are
+    from converged: more than :data:`MESH_NOTE_NOISE` times the frequency noise, and the
+    difference that remains may be the mesh's (study_tip_body.py: three bodies of
+    r 0.06-0.07 L between the nodes of 46 elements found within 6 % of their J, then
+    "unexplained" at χ²/n 2-4; their frequencies moved by up to 0.5 % at 92 elements, and
+    under 1e-6 with the body on a node)."""
+    if verdict == "consistent" or model.kind != "beam":
+        return []
+    h = model.element_length
+    inside = [e for e in model.effects if effect_type(e.name).point_moment
+              and "position" in e.parameters
+              and abs(e.parameters["position"] / h - round(e.parameters["position"] / h))
+              > 1e-6]
+    if not inside:
+        return []
+    from .modal import model_modes
+
+    count = measured.n_modes + 2   # (a free-free beam's two rigid modes)
+    try:
+        now = model_modes(model, count).frequencies_hz
+        finer = model_modes(model.with_elements(2 * model.elements), count).frequencies_hz
+    except (GfeSolverError, ValueError, np.linalg.LinAlgError):
+        return []
+    elastic = now > 1e-6 * np.max(now)
+    move = float(np.max(np.abs(finer[elastic] / now[elastic] - 1.0)))
+    if move <= MESH_NOTE_NOISE * est.freq:
+        return []
+    names = ", ".join(f"the {e.name} at {e.parameters['position']:.4g} m" for e in inside)
+    # the fewest elements from the model's that put a node within NODE_NEAR of an element
+    # of every such place (the fit then moves the place onto it as well as it fits)
+    places = np.array([e.parameters["position"] / model.length for e in inside])
+    near = next((n for n in range(model.elements + 1, 4 * model.elements + 1)
+                 if np.all(np.abs(places * n - np.round(places * n)) < NODE_NEAR)), None)
+    advice = "" if near is None else (f" (elements = {near} has one within "
+                                      f"{100 * NODE_NEAR:g} % of an element of it)")
+    return [f"{names} lie{'s' if len(inside) == 1 else ''} inside an element, where the "
+            "elements do not carry its moment exactly (the curvature jumps there): at "
+            f"{2 * model.elements} elements the model's frequencies move by up to "
+            f"{100 * move:.2g} % ({move / est.freq:.0f} times the "
+            f"{'stated' if est.given else 'assumed'} frequency noise), so the difference that "
+            f"remains may be the mesh's; a mesh with a node there reads it exactly{advice}"]
 
 
 def _band_caution(words, est: NoiseEstimate) -> list[str]:

@@ -23,6 +23,7 @@ class AttachedBody(EffectType):
                  "a moment J ẅ′ there)")
     kinds = ("beam",)
     local = True
+    point_moment = True
     present_at_null = ("inertia",)
     simpler = "point_mass"
     parameters = (

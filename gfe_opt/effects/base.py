@@ -289,6 +289,10 @@ class EffectType:
     #: lies within the significance's σ of nothing (a body whose J the data do not tell is
     #: the point mass): not offered in place of another effect nor as a pair's second then
     simpler: str | None = None
+    #: acts as a moment at a point (a body's rotary inertia): inside an element the
+    #: curvature jumps there, which the element's cubic cannot follow, so the model reads it
+    #: less exactly than at a node (:func:`gfe_opt.diagnosis._mesh_notes`)
+    point_moment: bool = False
     #: on a plane frame (``"frame"`` in :attr:`kinds`): the parameters that place the effect
     #: (a member, a node, a direction; chosen, not fitted), in place of a beam's ``side``
     frame_parameters: tuple = ()

@@ -18,6 +18,7 @@ class RotaryInertia(EffectType):
     signature = "a local rise of the coefficient of θ̈ at one node (a moment J ẅ′ there)"
     kinds = ("beam",)
     local = True
+    point_moment = True
     parameters = (
         Parameter("position", "m", "position", "where the body is attached"),
         Parameter("inertia", "kg m^2", "positive", "rotary inertia about the beam's "
