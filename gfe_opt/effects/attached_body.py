@@ -24,6 +24,9 @@ class AttachedBody(EffectType):
     kinds = ("beam",)
     local = True
     point_moment = True
+    #: not tried by default as a candidate of its own: ``diagnose`` reads a significant
+    #: point mass again as a body where nothing explains the data (selection step 6)
+    candidate = False
     present_at_null = ("inertia",)
     simpler = "point_mass"
     parameters = (
