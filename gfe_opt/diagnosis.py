@@ -32,6 +32,10 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
 6. When the best does not bring χ² to the stated (or assumed) noise, the free profiles are
    fitted as well, and a profile that explains significantly more than a best that
    explains only by white residuals is the finding.
+   If the best does not explain and a point mass is significant, the mass read again as
+   a body that turns with the beam (``attached_body``, from the point mass's place) is
+   the finding when it explains, or leaves less than :data:`FORM_SHARE` of what it
+   explains, with its J :data:`SIZE_SIGMAS` σ from 0 (:func:`_body_that_explains`).
    If the best does not explain: a pair that explains (estimable) is suggested (of the
    firsts the best does not beat significantly, with the same second, the lowest
    information criterion; :func:`_simplest_first`); else a free profile that explains is
@@ -1794,12 +1798,11 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
     data, or leaves less than :data:`FORM_SHARE` of what it explains (the rest as likely
     its own form: a body inside an element, whose moment the element's cubic cannot follow,
     :func:`_mesh_notes`), with its J at least :data:`SIZE_SIGMAS` σ from 0; else None.  It
-    is no candidate
-    of its own: as one it changed every threshold (one more candidate) and the floor, and a
-    body's J stood for a deep beam's shear beside a doubler (the continuum cases 2257 and
-    2265 of the seed-2100 campaign went wrong, one confidently); read from a point mass, it
-    is the one reading that finds a tip block (``scripts/study_tip_body.py``: a section loss
-    by the tip that is not there, otherwise)."""
+    is no candidate of its own: as one it changed every threshold (one more candidate) and
+    the floor, and a body's J stood for a deep beam's shear beside a doubler (the continuum
+    cases 2257 and 2265 of the seed-2100 campaign went wrong, one confidently); read from a
+    point mass, it is the one reading that finds a tip block (``scripts/study_tip_body.py``:
+    a section loss by the tip that is not there, otherwise)."""
     kind = effect_type(BODY)
     masses = [f for f in fits if f.name == "point_mass" and f.significant and not f.failed]
     if model.kind not in kind.kinds or not masses:
@@ -1825,8 +1828,9 @@ def _as_simpler(fit, model) -> bool:
     (:attr:`~gfe_opt.effects.base.EffectType.simpler`: a body whose J lies within
     :data:`SIZE_SIGMAS` σ of 0 is the point mass): then it is not offered where the
     information criterion alone ranks fits (a pair's second, the kind in a present effect's
-    place), as it is no finding among the candidates (the held-out continuum block 2769: a
-    lumped mass read as a body of J 2.7 σ from 0 named in the point mass's place)."""
+    place), as it is no finding among the candidates (with ``--candidates attached_body``;
+    while the body was a default candidate, the held-out continuum block 2769, a lumped
+    mass, was read as a body of J 2.7 σ from 0 in the point mass's place)."""
     kind = effect_type(fit.name)
     return kind.simpler is not None and kind.size_in_sigmas(
         model, fit.parameters, fit.uncertainty) < SIZE_SIGMAS
