@@ -34,8 +34,9 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
    explains only by white residuals is the finding.
    If the best does not explain and a point mass fitted, the mass read again as
    a body that turns with the beam (``attached_body``, from the point mass's place) is
-   the finding when it explains, or leaves less than :data:`FORM_SHARE` of what it
-   explains, with its J :data:`SIZE_SIGMAS` σ from 0 (:func:`_body_that_explains`).
+   the finding when it ranks first and explains (inside an element: when it does fitted
+   again on a mesh with a node by it), with its J :data:`SIZE_SIGMAS` σ from 0
+   (:func:`_body_that_explains`).
    If the best does not explain: a pair that explains (estimable) is suggested (of the
    firsts the best does not beat significantly, with the same second, the lowest
    information criterion; :func:`_simplest_first`); else a free profile that explains is
