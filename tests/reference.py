@@ -93,21 +93,17 @@ class ReferenceBeam:
         cols = np.tile(dofs, (1, 4)).ravel()
         K = sp.coo_matrix((ke.ravel(), (rows, cols)), shape=(size, size)).tolil()
         M = sp.coo_matrix((me.ravel(), (rows, cols)), shape=(size, size)).tolil()
-        for xp, value, target in ([(xp, m, M) for xp, m in self.point_masses]
-                                  + [(xp, k, K) for xp, k in self.point_springs]):
+        # point masses and springs on w's shape functions, a body's rotary inertia on the
+        # slope's (the derivative, index 1 of _hermite)
+        for xp, value, target, d in ([(xp, m, M, 0) for xp, m in self.point_masses]
+                                     + [(xp, k, K, 0) for xp, k in self.point_springs]
+                                     + [(xp, J, M, 1) for xp, J in self.point_inertias]):
             e = min(int(xp / h), n - 1)
-            shape = _hermite(np.array(xp / h - e), h)[0]
+            shape = _hermite(np.array(xp / h - e), h)[d]
             idx = dofs[e]
             for a in range(4):
                 for b in range(4):
                     target[idx[a], idx[b]] += value * shape[a] * shape[b]
-        for xp, J in self.point_inertias:
-            e = min(int(xp / h), n - 1)
-            slope = _hermite(np.array(xp / h - e), h)[1]
-            idx = dofs[e]
-            for a in range(4):
-                for b in range(4):
-                    M[idx[a], idx[b]] += J * slope[a] * slope[b]
         for side, k in self.end_springs.items():
             dof = 1 if side == "left" else 2 * n + 1
             K[dof, dof] += k
