@@ -9,10 +9,11 @@ from .base import (
     FIXED_TRANSLATION,
     EffectType,
     Parameter,
-    Variable,
     check_not_on_support,
-    position_variable,
+    inward,
 )
+from .point_mass import EFFECT as POINT_MASS
+from .rotary_inertia import inertia_variable
 
 
 class AttachedBody(EffectType):
@@ -47,18 +48,11 @@ class AttachedBody(EffectType):
         build.add_point_inertia(params["position"], params["inertia"])
 
     def variables(self, model, fixed):
-        # the point mass's place and mass; J in units of ρA L³ from 1e-8 (an accelerometer:
-        # nothing the modes tell) to 1 (a body as heavy as the beam, its radius of
-        # gyration as long)
-        return [position_variable(model),
-                Variable("mass", 1e-4, 3.0, (0.05, 0.2, 0.5),
-                         scale=lambda m: m.rho * m.area * m.length),
-                Variable("inertia", -8.0, 0.0, (-5.0, -4.0, -3.0, -2.0), log=True,
-                         scale=lambda m: m.rho * m.area * m.length**3)]
+        # the point mass's place and mass (a beam's), and J
+        return [*POINT_MASS.variables(model, fixed), inertia_variable()]
 
     def starts(self, model, hint):
-        return [{}, {"position": hint * model.length,
-                     "mass": 0.2 * model.rho * model.area * model.length}]
+        return POINT_MASS.starts(model, hint)
 
     def size_in_sigmas(self, model, params, sigma):
         """How far from a point mass, not from nothing: the inertia's distance from 0 in
@@ -72,11 +66,8 @@ class AttachedBody(EffectType):
         x = params["position"]
         ax.plot([x], [y], marker="s", color="tab:purple", ms=8, zorder=5)
         ax.plot([x], [y], marker="$\\circlearrowright$", color="tab:purple", ms=16, zorder=5)
-        # the label runs inwards from an end (centred, a tip body's was cut off)
-        side = x / model.length
-        ha = "right" if side > 0.7 else "left" if side < 0.3 else "center"
         ax.annotate(f"{1000 * params['mass']:.3g} g, J {params['inertia']:.3g} kg m²",
-                    (x, y), textcoords="offset points", xytext=(0, 10), ha=ha,
+                    (x, y), textcoords="offset points", xytext=(0, 10), ha=inward(model, x),
                     fontsize=7, color="tab:purple")
 
 

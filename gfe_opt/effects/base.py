@@ -146,6 +146,13 @@ def position_variable(model=None) -> Variable:
                     scale=lambda model: model.length)
 
 
+def inward(model, x: float) -> str:
+    """The alignment of a label at x that runs inwards from an end of the sketch (centred,
+    a tip body's was cut off)."""
+    side = x / model.length
+    return "right" if side > 0.7 else "left" if side < 0.3 else "center"
+
+
 def end_at(model, x: float) -> tuple[str, str] | None:
     """``("left", support)`` or ``("right", support)`` when x lies on an end, else None."""
     tol = 1e-9 * model.length

@@ -5,10 +5,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import EffectType, Parameter, Variable, check_not_on_support
+from .base import EffectType, Parameter, Variable, check_not_on_support, inward
 
 #: supports that hold the rotation still: a rotary inertia there does nothing
 FIXED_ROTATION = ("clamped", "sliding")
+
+
+def inertia_variable() -> Variable:
+    """A body's J in units of ρA L³, from 1e-8 (an accelerometer on a long beam: nothing
+    the modes tell) to 1 (a body as heavy as the beam with a radius of gyration as long);
+    ``attached_body``'s too."""
+    return Variable("inertia", -8.0, 0.0, (-5.0, -4.0, -3.0, -2.0), log=True,
+                    scale=lambda m: m.rho * m.area * m.length**3)
 
 
 class RotaryInertia(EffectType):
@@ -40,14 +48,10 @@ class RotaryInertia(EffectType):
 
     def variables(self, model, fixed):
         # its place along the beam (each end whose rotation is free: the tip of a
-        # cantilever); J in units of ρA L³, from 1e-8 (an accelerometer on a long beam:
-        # nothing the modes tell) to 1 (a body as heavy as the beam with a radius of
-        # gyration as long)
+        # cantilever) and J
         ends = tuple(float(end) for end in (0, 1) if model.supports[end] not in FIXED_ROTATION)
         return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)) + ends,
-                         scale=lambda m: m.length),
-                Variable("inertia", -8.0, 0.0, (-5.0, -4.0, -3.0, -2.0), log=True,
-                         scale=lambda m: m.rho * m.area * m.length**3)]
+                         scale=lambda m: m.length), inertia_variable()]
 
     def starts(self, model, hint):
         """At each attached mass of the model (the body whose inertia it is); else from
@@ -59,10 +63,8 @@ class RotaryInertia(EffectType):
     def mark(self, ax, model, params, sigma, y, bounds=None):
         x = params["position"]
         ax.plot([x], [y], marker="$\\circlearrowright$", color="tab:purple", ms=11, zorder=5)
-        side = x / model.length
-        ha = "right" if side > 0.7 else "left" if side < 0.3 else "center"
         ax.annotate(f"J {params['inertia']:.3g} kg m²", (x, y), textcoords="offset points",
-                    xytext=(0, -14), ha=ha, fontsize=7, color="tab:purple")
+                    xytext=(0, -14), ha=inward(model, x), fontsize=7, color="tab:purple")
 
 
 EFFECT = RotaryInertia()
