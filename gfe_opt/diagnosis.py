@@ -1824,13 +1824,27 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
         return None
     seeds = [{"position": f.parameters["position"], "mass": f.parameters["mass"]}
              for f in masses]
-    (body,) = _run_jobs([("candidate", (model, measured, BODY, noise, hint, None, (),
-                                        seeds))], None, [f"{BODY} from the point mass"])
+    if model.kind == "frame":
+        # on the point mass's member, from its place and mass and the member's own grid
+        # (not on every member, as a candidate is fitted: the body is the mass read again)
+        members = [f.parameters["member"] for f in masses]
+        groups = [[{"member": m}, {**seed, "member": m}] for m, seed in zip(members, seeds)]
+        bodies = _run_jobs([("group", (model, measured, BODY, noise, group, (), False))
+                            for group in groups], None,
+                           [f"{BODY} from the point mass"] * len(groups))
+        body = bodies[0]
+        for fit in bodies[1:]:
+            body = fit if _preferred(fit, body) else body
+    else:
+        (body,) = _run_jobs([("candidate", (model, measured, BODY, noise, hint, None, (),
+                                            seeds))], None, [f"{BODY} from the point mass"])
     if not body.success or body.unidentified \
             or kind.size_in_sigmas(model, body.parameters, body.uncertainty) < SIZE_SIGMAS:
         return None
     if explains(body):
         return body
+    if model.kind == "frame":   # (a frame member's mesh is not refined here)
+        return None
     # a body inside an element: its moment is not carried exactly there (:func:`_mesh_notes`);
     # it stands when, fitted again on a mesh with a node by it, it explains the data (not a
     # J that stands for a deep beam's shear: continuum-block-clamped-free-2258, a J of r 10 %

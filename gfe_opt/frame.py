@@ -23,6 +23,9 @@ Model file (``kind = "frame"``; README "Plane frames")::
                  effect = "support_spring": node, stiffness (N m/rad; a support's rotation)
                  effect = "support_translation": node, direction = "x" | "y", stiffness (N/m)
                  effect = "point_mass": member, position, mass (kg)
+                 effect = "attached_body": member, position, mass (kg), inertia (kg m²;
+                          a body that moves in x and y and turns with the frame there)
+                 effect = "rotary_inertia": member, position, inertia (kg m²)
                  effect = "point_spring": member, position, direction = "x" | "y",
                           stiffness (N/m; a spring to ground along x or y there)
                  effect = "axial_stiffness": member, ratio;  effect = "material": E (Pa)
@@ -58,7 +61,7 @@ SUPPORT_TYPES = {"clamped": (0, 1, 2), "pinned": (0, 1), "roller-x": (1,), "roll
 FRAME_EFFECTS = ("crack", "joint_spring", "support_spring", "support_translation",
                  "point_mass", "point_spring", "axial_stiffness", "material", "section_loss",
                  "axial_load", "foundation", "shear", "stiffness_profile", "member_shear",
-                 "mass_profile")
+                 "mass_profile", "rotary_inertia", "attached_body")
 #: the fixity each support effect replaces by a spring: rotation; translation along x / y
 RELEASES = {"support_spring": 2, "x": 0, "y": 1}
 
@@ -340,8 +343,8 @@ def _effect(model: FrameModel, raw: dict, where: str, prefix: str) -> dict:
     if member_id not in {m.id for m in model.members}:
         raise GfeInputError(where, prefix + "member", f"no member {member_id!r}")
     member = model.member(member_id)
-    if name == "point_mass":
-        return _point_mass(model, member, raw, where, prefix)
+    if name in ("point_mass", "attached_body", "rotary_inertia"):
+        return _point_mass(model, member, raw, where, prefix, name)
     if name == "point_spring":
         return _point_spring(model, member, raw, where, prefix)
     if name == "axial_stiffness":
@@ -445,21 +448,35 @@ def _member_place(model: FrameModel, member: Member, raw: dict, where: str, pref
     return x, (member.start if x == 0.0 else member.end if x == length else None)
 
 
-def _point_mass(model: FrameModel, member: Member, raw: dict, where: str, prefix: str):
+def _point_mass(model: FrameModel, member: Member, raw: dict, where: str, prefix: str,
+                name: str = "point_mass"):
     """A mass on a member at ``position`` (m from its start; an end is the joint there),
-    held by neither support translation of its place."""
+    held by neither support translation of its place; a body (``attached_body``: its mass
+    and its rotary inertia) or a body's rotary inertia alone (``rotary_inertia``), held
+    by no support of its rotation."""
     from .effects.base import no_unknown
     from .model import _number
 
-    no_unknown(raw, {"effect", "member", "position", "mass"}, where, prefix)
+    keys = {"mass"} if name == "point_mass" else {"inertia"} if name == "rotary_inertia" \
+        else {"mass", "inertia"}
+    no_unknown(raw, {"effect", "member", "position", *keys}, where, prefix)
     x, end = _member_place(model, member, raw, where, prefix)
-    mass = _number(raw, "mass", where, positive=True, prefix=prefix)
+    out = {"effect": name, "member": member.id, "position": x}
+    for key in ("mass", "inertia"):
+        if key in keys:
+            out[key] = _number(raw, key, where, positive=True, prefix=prefix)
     support = dict(model.supports).get(end)
-    if {0, 1} <= set(SUPPORT_TYPES.get(support, ())):
+    held = set(SUPPORT_TYPES.get(support, ()))
+    if "mass" in keys and {0, 1} <= held:
         raise GfeInputError(where, prefix + "position", f"node {end!r} is a {support} support "
-                            "that holds the structure still: a mass there does nothing")
-    return _as_effect({"effect": "point_mass", "member": member.id, "position": x,
-                       "mass": mass})
+                            "that holds the structure still: a mass there does nothing" + (
+                                " (for the body's rotary inertia alone: rotary_inertia)"
+                                if name == "attached_body" and 2 not in held else ""))
+    if name == "rotary_inertia" and 2 in held:
+        raise GfeInputError(where, prefix + "position", f"node {end!r} is a {support} support "
+                            "that holds the rotation still: a rotary inertia there does "
+                            "nothing")
+    return _as_effect(out)
 
 
 def _point_spring(model: FrameModel, member: Member, raw: dict, where: str, prefix: str):
@@ -537,7 +554,8 @@ def check_repeats(effects, where) -> None:
 def _effect_key(effect) -> tuple | None:
     """What two instances of a frame effect may not share (a crack may repeat)."""
     e = {"effect": effect.name, **effect.parameters}
-    if e["effect"] in ("crack", "point_mass", "point_spring", "section_loss"):
+    if e["effect"] in ("crack", "point_mass", "point_spring", "section_loss", "attached_body",
+                       "rotary_inertia"):
         return None
     if e["effect"] in ("material", "shear"):
         return (e["effect"],)
@@ -951,6 +969,9 @@ def frame_matrices(model: FrameModel, mesh: FrameMesh | None = None):
     masses = _attached(model, mesh, "point_mass")
     if masses is not None:
         M = M + _outer_sum(*masses)
+    turning = _turning(model, mesh)
+    if turning is not None:
+        M = M + _outer_sum(*turning)
     points = _attached(model, mesh, "point_spring")
     if points is not None:
         K = K + _outer_sum(*points)
@@ -965,7 +986,8 @@ def _attached(model: FrameModel, mesh: FrameMesh, name: str):
     m (cx cxᵀ + cy cyᵀ) to M and the spring k c cᵀ to K.  The readings are kept a few at a
     time (:func:`~gfe_opt.frame_data.attached_reading`; a fitted place moves at every
     evaluation, the fits of other effects read the same place again)."""
-    found = [e for e in model.raw_effects if e["effect"] == name]
+    names = (name, "attached_body") if name == "point_mass" else (name,)
+    found = [e for e in model.raw_effects if e["effect"] in names]
     if not found:
         return None
     from .frame_data import attached_reading  # as a sensor reads them, Timoshenko or not
@@ -979,6 +1001,26 @@ def _attached(model: FrameModel, mesh: FrameMesh, name: str):
                    "direction": e["direction"]} for e in found]
         values = np.array([float(e["stiffness"]) for e in found])
     return attached_reading(model, mesh, places), values
+
+
+#: the effects that add a rotary inertia J at a point of a frame (:func:`_turning`)
+TURNING = ("attached_body", "rotary_inertia")
+
+
+def _turning(model: FrameModel, mesh: FrameMesh, effects=None):
+    """(C, J) of the rotary inertias of the frame's bodies (``attached_body``,
+    ``rotary_inertia``; ``effects``: those raw effects instead): the rotation at each place
+    (:func:`~gfe_opt.frame_data.rotation_reading`), so that each adds J c cᵀ to M; None
+    when it has none."""
+    found = [e for e in (model.raw_effects if effects is None else effects)
+             if e["effect"] in TURNING]
+    if not found:
+        return None
+    from .frame_data import rotation_reading
+
+    return rotation_reading(model, mesh, [{"member": e["member"], "position": e["position"]}
+                                          for e in found]), \
+        np.array([float(e["inertia"]) for e in found])
 
 
 def _outer_sum(C, values) -> sp.csr_matrix:
@@ -1014,7 +1056,7 @@ def local_difference(models, weights, index: int):
     the whole matrices, as :func:`gfe_opt.assembly.local_difference` does on a beam."""
     first = models[0]
     name = first.effects[index].name
-    local = name in _ELEMENT_EFFECTS or name in ("point_mass", "point_spring")
+    local = name in _ELEMENT_EFFECTS or name in ("point_mass", "point_spring", *TURNING)
     if not local or name == "member_shear" or any(has_shear(m) for m in models):
         return None
     meshes = [frame_mesh(m) for m in models]
@@ -1052,18 +1094,22 @@ def local_difference(models, weights, index: int):
     parts = []
     for m, x in zip(models, meshes):
         e = m.raw_effects[index]
-        if name == "point_mass":
+        part = sp.csr_matrix((n, n))
+        if name in ("point_mass", "attached_body"):
             places = [{"member": e["member"], "position": e["position"], "direction": d}
                       for d in ("x", "y")]
-            values = np.repeat([e["mass"]], 2)
-        else:
+            part = _outer_sum(attached_reading(m, x, places), np.repeat([e["mass"]], 2))
+        elif name == "point_spring":
             places = [{"member": e["member"], "position": e["position"],
                        "direction": e["direction"]}]
-            values = np.array([float(e["stiffness"])])
-        parts.append(_outer_sum(attached_reading(m, x, places), values))
+            part = _outer_sum(attached_reading(m, x, places),
+                              np.array([float(e["stiffness"])]))
+        if name in TURNING:
+            part = part + _outer_sum(*_turning(m, x, [e]))
+        parts.append(part)
     change = sp.csr_matrix(weighted(parts))
     zero = sp.csr_matrix((n, n))
-    return (zero, change) if name == "point_mass" else (change, zero)
+    return (change, zero) if name == "point_spring" else (zero, change)
 
 
 def _footprint(models, index: int, k: int) -> np.ndarray | None:

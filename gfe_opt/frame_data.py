@@ -407,6 +407,39 @@ def build_observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_mat
     return sp.csr_matrix((vals, (rows, cols)), shape=(len(sensors), mesh.n_dof))
 
 
+def rotation_reading(model: FrameModel, mesh: FrameMesh, places) -> sp.csr_matrix:
+    """The rotation θ (rad) at each of ``places`` ({"member", "position"}, m from the
+    member's start) from the mesh's DOFs: at a member's end the joint's own θ (a body
+    attached at a joint turns with the joint, a member end a ``joint_spring`` frees
+    included); between nodes the slope of the member's cubic, dv/ds (rotation is the same
+    angle in the member's axes and the frame's).  What a body's rotary inertia J adds to M
+    is J c cᵀ (``attached_body``, ``rotary_inertia``)."""
+    rows, cols, vals = [], [], []
+    for i, place in enumerate(places):
+        member = model.member(place["member"])
+        length = model.member_length(member)
+        x = float(place["position"])
+        end = member.start if x <= 1e-12 * length else \
+            member.end if x >= length * (1 - 1e-12) else None
+        if end is not None:
+            rows.append(i)
+            cols.append(mesh.node_dofs[end][2])
+            vals.append(1.0)
+            continue
+        k = next(j for j, m in enumerate(model.members) if m.id == member.id)
+        L = length / member.elements
+        j = min(int(x // L), member.elements - 1)
+        xi = x / L - j
+        e = int(np.flatnonzero(mesh.element_member == k)[0]) + j
+        T = rotations(mesh.cosines[e:e + 1])[0]       # global -> member axes
+        slope = np.zeros(6)                          # dv/ds from the local DOFs
+        slope[[1, 2, 4, 5]] = el.hermite_d1(xi) * el.beam_dof_scaling(L) / L
+        rows += [i] * 6
+        cols += mesh.element_dofs[e].tolist()
+        vals += (slope @ T).tolist()
+    return sp.csr_matrix((vals, (rows, cols)), shape=(len(places), mesh.n_dof))
+
+
 #: shape residuals below this (relative to the largest amplitude) are rounding: far above
 #: eps times the condition of a frame's modal solve, far below any sensor's noise
 ROUNDING = 1e-9

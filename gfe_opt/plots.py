@@ -624,6 +624,7 @@ def frame_localisation(members, points, residual, worst, labels):
 FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "support_spring": ("D", "tab:brown"), "support_translation": ("D", "tab:brown"),
                "point_mass": ("s", "tab:purple"), "point_spring": ("^", "tab:green"),
+               "attached_body": ("p", "tab:purple"), "rotary_inertia": ("P", "tab:purple"),
                "axial_stiffness": (None, "tab:blue"),
                "axial_load": (None, "tab:cyan"), "foundation": (None, "tab:olive"),
                "shear": ("*", "tab:pink"), "stiffness_profile": (None, "goldenrod"),

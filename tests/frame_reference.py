@@ -131,12 +131,15 @@ class ExactFrame:
     ``member_ids`` the members' names (for sensors on them), ``ground_springs`` [(node, DOF
     0/1/2 for u/v/θ, k)]: a support's fixity of that DOF replaced by a spring to ground
     (a direction (cx, cy) for the DOF: a spring to ground along it at a node left free);
-    ``masses`` [(node, kg)]: a rigid mass at a node (it moves in x and y)."""
+    ``masses`` [(node, kg)] or [(node, kg, J)]: a rigid mass at a node (it moves in x and
+    y; with J [kg m²], a body that also turns with the joint)."""
 
     def __init__(self, nodes, members, supports, joint_springs=(), member_ids=None,
                  ground_springs=(), masses=()):
         self.ids = list(nodes)
-        self.masses = [(3 * self.ids.index(node) + d, m) for node, m in masses for d in (0, 1)]
+        self.masses = [(3 * self.ids.index(body[0]) + d, value) for body in masses
+                       for d, value in ((0, body[1]), (1, body[1]),
+                                        (2, body[2] if len(body) > 2 else 0.0))]
         self.ground = [(3 * self.ids.index(node) + dof, k) for node, dof, k in ground_springs
                        if not isinstance(dof, tuple)]
         # a spring to ground along a direction (cx, cy) at a node no support holds there

@@ -22,9 +22,10 @@ class AttachedBody(EffectType):
                "and its rotary inertia J turns with the slope there (a point_mass with J)")
     signature = ("a local rise of the coefficients of ẅ and θ̈ at one node (a force m ẅ and "
                  "a moment J ẅ′ there)")
-    kinds = ("beam",)
+    kinds = ("beam", "frame")
     local = True
     point_moment = True
+    frame_parameters = POINT_MASS.frame_parameters
     #: not tried by default as a candidate of its own: ``diagnose`` reads a significant
     #: point mass again as a body where nothing explains the data (selection step 6)
     candidate = False
@@ -48,11 +49,15 @@ class AttachedBody(EffectType):
         build.add_point_inertia(params["position"], params["inertia"])
 
     def variables(self, model, fixed):
-        # the point mass's place and mass (a beam's), and J
-        return [*POINT_MASS.variables(model, fixed), inertia_variable()]
+        # the point mass's place and mass (a beam's; a frame member's), and J
+        member = model.member(fixed["member"]) if model.kind == "frame" else None
+        return [*POINT_MASS.variables(model, fixed), inertia_variable(member)]
 
     def starts(self, model, hint):
         return POINT_MASS.starts(model, hint)
+
+    def frame_placeholders(self, model, params):
+        return {**POINT_MASS.frame_placeholders(model, params), "inertia": 1.0}
 
     def size_in_sigmas(self, model, params, sigma):
         """How far from a point mass, not from nothing: the inertia's distance from 0 in

@@ -5,18 +5,35 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import EffectType, Parameter, Variable, check_not_on_support, inward
+from .base import (
+    EffectType,
+    Parameter,
+    Variable,
+    check_not_on_support,
+    frame_free_ends,
+    frame_position_variable,
+    inward,
+)
 
 #: supports that hold the rotation still: a rotary inertia there does nothing
 FIXED_ROTATION = ("clamped", "sliding")
 
 
-def inertia_variable() -> Variable:
+def inertia_variable(member=None) -> Variable:
     """A body's J in units of ρA L³, from 1e-8 (an accelerometer on a long beam: nothing
     the modes tell) to 1 (a body as heavy as the beam with a radius of gyration as long);
-    ``attached_body``'s too."""
+    ``attached_body``'s too.  On a frame, ``member``'s own ρA L³."""
+    if member is None:
+        return Variable("inertia", -8.0, 0.0, (-5.0, -4.0, -3.0, -2.0), log=True,
+                        scale=lambda m: m.rho * m.area * m.length**3)
     return Variable("inertia", -8.0, 0.0, (-5.0, -4.0, -3.0, -2.0), log=True,
-                    scale=lambda m: m.rho * m.area * m.length**3)
+                    scale=lambda m: member.rho * member.area * m.member_length(member)**3)
+
+
+def frame_body_place(model, member, held) -> Variable:
+    """A body's place along a frame ``member``: its 19 interior places and each end whose
+    node no support holds in every DOF of ``held`` (0 x, 1 y, 2 θ)."""
+    return frame_position_variable(model, member, frame_free_ends(model, member, held))
 
 
 class RotaryInertia(EffectType):
@@ -24,9 +41,11 @@ class RotaryInertia(EffectType):
     physics = ("the rotary inertia J of a body attached at one point, which turns with the "
                "beam's slope there (kinetic energy J θ̇²/2); its mass is a point_mass")
     signature = "a local rise of the coefficient of θ̈ at one node (a moment J ẅ′ there)"
-    kinds = ("beam",)
+    kinds = ("beam", "frame")
     local = True
     point_moment = True
+    frame_parameters = (Parameter("member", "", "choice", "the member (a frame; position "
+                                  "from its start node, an end is the joint)"),)
     parameters = (
         Parameter("position", "m", "position", "where the body is attached"),
         Parameter("inertia", "kg m^2", "positive", "rotary inertia about the beam's "
@@ -49,6 +68,9 @@ class RotaryInertia(EffectType):
     def variables(self, model, fixed):
         # its place along the beam (each end whose rotation is free: the tip of a
         # cantilever) and J
+        if model.kind == "frame":
+            member = model.member(fixed["member"])
+            return [frame_body_place(model, member, (2,)), inertia_variable(member)]
         ends = tuple(float(end) for end in (0, 1) if model.supports[end] not in FIXED_ROTATION)
         return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)) + ends,
                          scale=lambda m: m.length), inertia_variable()]
@@ -56,9 +78,18 @@ class RotaryInertia(EffectType):
     def starts(self, model, hint):
         """At each attached mass of the model (the body whose inertia it is); else from
         the grid along the beam."""
+        if model.kind == "frame":
+            places = [{"member": e.parameters["member"],
+                       "position": float(e.parameters["position"])}
+                      for e in model.effects if e.name == "point_mass"]
+            return places or [{"member": m.id} for m in model.members]
         places = sorted({float(e.parameters["position"]) for e in model.effects
                          if e.name == "point_mass" and "position" in e.parameters})
         return [{"position": x} for x in places] or [{}]
+
+    def frame_placeholders(self, model, params):
+        return {"position": 0.5 * model.member_length(model.member(params["member"])),
+                "inertia": 1.0}
 
     def mark(self, ax, model, params, sigma, y, bounds=None):
         x = params["position"]
