@@ -545,9 +545,11 @@ def _groups(name, starts, given, seeds) -> list[list[dict]]:
 
 
 def _fit_group(model, measured, name, noise, group, extra, thorough):
+    every = effect_type(name).every_start(model)   # (each start run to its end)
     return fit_effects(model, measured, [*extra, Effect(name, group[0])], noise=noise,
                        name=name, alternatives=group[1:],
-                       multistart=("valleys" if thorough and not measured.frequency_only
+                       multistart=(True if every else
+                                   "valleys" if thorough and not measured.frequency_only
                                    else True if (extra or thorough) and measured.frequency_only
                                    else "auto"))
 
@@ -1825,13 +1827,13 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
     seeds = [{"position": f.parameters["position"], "mass": f.parameters["mass"]}
              for f in masses]
     if model.kind == "frame":
-        # on the point mass's member, from its place and mass and the member's own grid
-        # (not on every member, as a candidate is fitted: the body is the mass read again)
-        members = [f.parameters["member"] for f in masses]
-        groups = [[{"member": m}, {**seed, "member": m}] for m, seed in zip(members, seeds)]
-        bodies = _run_jobs([("group", (model, measured, BODY, noise, group, (), False))
-                            for group in groups], None,
-                           [f"{BODY} from the point mass"] * len(groups))
+        # on the point mass's member (and those of its length, as ``update --add
+        # attached_body:member=...`` fits it), not on every member as a candidate is fitted:
+        # the body is the mass read again
+        bodies = _run_jobs([("candidate", (model, measured, BODY, noise, hint,
+                                           {"member": f.parameters["member"]}, (), [seed]))
+                            for f, seed in zip(masses, seeds)], None,
+                           [f"{BODY} from the point mass"] * len(masses))
         body = bodies[0]
         for fit in bodies[1:]:
             body = fit if _preferred(fit, body) else body

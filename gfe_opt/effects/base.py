@@ -320,6 +320,13 @@ class EffectType:
         asks for that one in the model)."""
         return True
 
+    def every_start(self, model) -> bool:
+        """Whether a fit of it on ``model`` runs from each of its starts (:meth:`starts`
+        with the same place) to its end and keeps the best, not only from the best grid
+        point over them (a frame's body: a point mass that slides off a joint stands for a
+        small J, a valley the grid's best point lies in)."""
+        return False
+
     def is_local(self, model) -> bool:
         """Whether the effect may appear more than once in ``model`` (:attr:`local`; an
         effect global on a beam may be one a member on a frame)."""
