@@ -632,16 +632,16 @@ def test_a_mass_at_a_corner_of_the_symmetric_portal_names_the_corner_it_cannot_t
     assert at_c.model.effects[0].parameters["mass"] == pytest.approx(mass, rel=0.1)
 
 
-def _body_at_corner(mass, radius, seed, known=False):
-    """The portal with a body at joint C (``mass`` kg, J = mass radius²) in the exact
-    frame (its mass and J on the joint's DOFs), and the model (``known``: holding the
-    body's mass as a point mass there)."""
+def _body_at_corner(mass, radius, seed, known=False, node="C"):
+    """The portal with a body at joint ``node`` (B or C; ``mass`` kg, J = mass radius²) in
+    the exact frame (its mass and J on the joint's DOFs), and the model (``known``: holding
+    the body's mass as a point mass there)."""
     model = portal_frame()
     base = _exact(model)
     inertia = mass * radius**2
     exact = ExactFrame(base.nodes, base.members, dict(model.supports), (), base.member_ids,
-                       (), [("C", mass, inertia)])
-    end = model.member_length(model.member("beam"))
+                       (), [(node, mass, inertia)])
+    end = model.member_length(model.member("beam")) if node == "C" else 0.0
     truth = [Effect("attached_body", {"member": "beam", "position": end, "mass": mass,
                                       "inertia": inertia})]
     measured = _measured(model, exact, _guess(model, truth), _sensors(model), seed)
