@@ -651,23 +651,25 @@ def _body_at_corner(mass, radius, seed, known=False, node="C"):
     return model, measured, inertia
 
 
-def test_a_body_at_a_frame_corner_is_found_with_its_rotary_inertia():
-    """A block on the portal's corner C, 0.3 kg (a fifth of the beam's mass) with a radius
-    of gyration of 3 cm: its rotary inertia turns with the joint.  The diagnosis reads the
-    point mass again as a body (``attached_body``, selection step 6): at C within 2 % of
-    the beam, its mass within 2 %, its J within 5 %; ``consistent`` after ``update``.
-    Before frames took the body, the point mass alone left χ²/n 77 and a section loss by
-    the corner was named first."""
+@pytest.mark.parametrize("node, mass, radius", [("C", 0.3, 0.03), ("B", 0.136, 0.0104)])
+def test_a_body_at_a_frame_corner_is_found_with_its_rotary_inertia(node, mass, radius):
+    """A block on a corner of the portal whose rotary inertia turns with the joint: 0.3 kg
+    (a fifth of the beam's mass) of radius of gyration 3 cm on C, and 136 g of 1 cm on B.
+    The diagnosis reads the point mass again as a body (``attached_body``, selection step
+    6): at the corner (within 2 % of a member's length), its mass and J within 3 σ of the
+    truth; ``consistent`` after ``update``.  Before frames took the body, the point mass
+    alone left χ²/n 77 on C and a section loss by the corner was named first; the small
+    block on B was read as a point mass 1.04 ± 0.05 cm into the beam."""
     from gfe_opt.frame_data import effect_place
 
-    model, measured, inertia = _body_at_corner(0.3, 0.03, 5)
+    model, measured, inertia = _body_at_corner(mass, radius, 5, node=node)
     d = _diagnose(model, measured, **NOISE)
     assert d.verdict == "effect_found" and d.suggested == ["attached_body"], d.notes
-    body = d.best.effects[-1]
-    assert body.parameters["member"] == "beam"
-    assert body.parameters["mass"] == pytest.approx(0.3, rel=0.02)
-    assert body.parameters["inertia"] == pytest.approx(inertia, rel=0.05)
-    assert effect_place(model, body) == "node C"
+    body, sigma = d.best.effects[-1], d.best.sigma[-1]
+    assert effect_place(model, body) == f"node {node}"
+    for key, truth in (("mass", mass), ("inertia", inertia)):
+        assert abs(body.parameters[key] - truth) < 3 * sigma[key], (key, body, sigma)
+        assert body.parameters[key] == pytest.approx(truth, rel=0.2)
     after = update(model, measured, d.add_arguments(), **NOISE)
     assert _diagnose(after.model, measured, **NOISE).verdict == "consistent"
 
