@@ -1818,7 +1818,10 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
     the floor, and a body's J stood for a deep beam's shear beside a doubler (the continuum
     cases 2257 and 2265 of the seed-2100 campaign went wrong, one confidently); read from a
     point mass, it is the one reading that finds a tip block (``scripts/study_tip_body.py``:
-    a section loss by the tip that is not there, otherwise)."""
+    a section loss by the tip that is not there, otherwise).  On a frame it is fitted on
+    each mass's member and its mirror image, from the mass's place and mass with each J of
+    the grid (``scripts/study_frame_body.py``), and also where an effect explains the data
+    (:func:`_diagnose`); a frame's member is not refined for a body inside an element."""
     kind = effect_type(BODY)
     # any point mass fitted, determined or not (a heavy body on a free end: the point mass
     # alone there, 1.17 kg ± 1.2 for 0.33 kg, left 45 % of the difference, and a spring by

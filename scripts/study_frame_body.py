@@ -19,7 +19,8 @@ on either member at that joint), within 2 % of its member's length, its mass wit
 its J within 15 %.  A body at the mirror corner with the diagnosis's note that the data
 cannot tell the two apart is counted apart ("mirror said"), and so is a body whose J the
 data do not tell: the loop ends ``consistent`` with its point mass, in place, its mass
-within 5 % ("J untold").
+within 5 % ("J untold"), and one whose J lies beyond 15 % but within 3 σ of the truth ("J
+within 3 σ").
 """
 
 from __future__ import annotations
@@ -45,6 +46,18 @@ STATED = {"shape_noise": 0.003, "freq_noise": 0.0005}
 STEPS = 4
 
 
+class _Exact(ExactFrame):
+    """The exact frame, its roots bracketed within 1 % where 0.1 % of the finite-element
+    guess misses them (a body inside an element of the guess's mesh: its moment is not
+    carried exactly there, README "A body that turns with the beam")."""
+
+    def frequency_near(self, estimate_hz, width=1e-3):
+        try:
+            return super().frequency_near(estimate_hz, width)
+        except ValueError:
+            return super().frequency_near(estimate_hz, 1e-2)
+
+
 def _exact_with_body(model, member_id, at, mass, inertia):
     """The exact portal with the body at ``at`` m along ``member_id`` (a joint when at an
     end), and the map of a sensor of the model to the exact frame's own."""
@@ -53,8 +66,8 @@ def _exact_with_body(model, member_id, at, mass, inertia):
     length = model.member_length(m)
     if at in (0.0, length):
         node = m.start if at == 0.0 else m.end
-        return ExactFrame(base.nodes, base.members, dict(model.supports), (),
-                          base.member_ids, (), [(node, mass, inertia)]), None
+        return _Exact(base.nodes, base.members, dict(model.supports), (),
+                      base.member_ids, (), [(node, mass, inertia)]), None
     (x0, y0), (x1, y1) = model.nodes[m.start], model.nodes[m.end]
     t = at / length
     nodes = {**model.nodes, "K": (x0 + t * (x1 - x0), y0 + t * (y1 - y0))}
@@ -67,8 +80,8 @@ def _exact_with_body(model, member_id, at, mass, inertia):
         else:
             members.append(row)
             names.append(name)
-    exact = ExactFrame(nodes, members, dict(model.supports), (), names, (),
-                       [("K", mass, inertia)])
+    exact = _Exact(nodes, members, dict(model.supports), (), names, (),
+                   [("K", mass, inertia)])
 
     def where(s):
         if s.get("member") != member_id:
@@ -100,7 +113,7 @@ def case(seed: int, k: int) -> dict:
     sensors = _sensors(model)
     measured = _measured(model, exact, _guess(model, [truth]), sensors, seed, where=where)
     start = time.perf_counter()
-    verdicts, added, notes = [], [], []
+    verdicts, added, notes, fit = [], [], [], None
     for _ in range(STEPS):
         d = diagnose(model, measured, **STATED)
         verdicts.append(d.verdict)
@@ -108,7 +121,8 @@ def case(seed: int, k: int) -> dict:
         if d.verdict != "effect_found":
             break
         added += list(d.suggested)
-        model = update(model, measured, d.add_arguments(), **STATED).model
+        fit = update(model, measured, d.add_arguments(), **STATED).fit
+        model = fit.model
     found = [(e.name, dict(e.parameters)) for e in model.effects]
     names = sorted(n for n, _ in found)
     place = effect_place(model, truth)
@@ -131,6 +145,14 @@ def case(seed: int, k: int) -> dict:
             abs(e.parameters["position"] - at) <= 0.02 * length
 
     right = shape and all(at_place(e) for e in bodies)
+    # J outside 15 % but within 3 σ of the truth (σ of the last update's fit): a small J the
+    # data tell only roughly, said with its uncertainty
+    sigma_j = [sig.get("inertia") for e, sig in zip(fit.effects, fit.sigma)
+               if e.name in ("attached_body", "rotary_inertia")] if fit is not None else []
+    loose = (not right and bool(inertia) and verdicts[-1] == "consistent"
+             and names in [sorted(x) for x in kinds] and abs(fitted_mass / mass - 1) < 0.05
+             and all(at_place(e) for e in bodies) and len(sigma_j) == 1
+             and sigma_j[0] is not None and abs(fitted_inertia - inertia) < 3 * sigma_j[0])
     mirror = shape and not right and bool(notes)
     # a body whose J these data do not tell: the loop ends consistent with its point mass,
     # in place, and rotary_inertia (tried on a model holding a point mass) not significant
@@ -139,7 +161,7 @@ def case(seed: int, k: int) -> dict:
     return {"case": seed, "member": member_id, "position": at, "place": place, "mass": mass,
             "inertia": inertia, "verdicts": verdicts, "added": added, "found": found,
             "found_places": places, "right": bool(right), "mirror_said": bool(mirror),
-            "inertia_untold": untold,
+            "inertia_untold": untold, "inertia_within_3_sigma": bool(loose),
             "seconds": time.perf_counter() - start}
 
 
@@ -154,7 +176,8 @@ def main() -> None:
         row = case(args.seed + k, k)
         rows.append(row)
         mark = "right" if row["right"] else "mirror said" if row["mirror_said"] else \
-            "J untold" if row["inertia_untold"] else "WRONG"
+            "J untold" if row["inertia_untold"] else \
+            "J within 3 σ" if row["inertia_within_3_sigma"] else "WRONG"
         print(f"[{k + 1}/{args.cases}] {row['case']} body at {row['place']}, "
               f"{1e3 * row['mass']:.1f} g, J {row['inertia']:.3g}: "
               f"{' -> '.join(row['verdicts'])} added {row['added']} {mark} "
@@ -164,8 +187,10 @@ def main() -> None:
     right = sum(r["right"] for r in rows)
     said = sum(r["mirror_said"] for r in rows)
     untold = sum(r["inertia_untold"] for r in rows)
-    print(f"right {right} of {len(rows)} (mirror corner said: {said}; a point mass in place, "
-          f"consistent, its J not told by the data: {untold})")
+    loose = sum(r["inertia_within_3_sigma"] for r in rows)
+    print(f"right {right} of {len(rows)} (J beyond 15 % but within 3 σ of the truth: {loose}; "
+          f"mirror corner said: {said}; a point mass in place, consistent, its J not told by "
+          f"the data: {untold})")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
 

@@ -68,8 +68,8 @@ class AttachedBody(EffectType):
         # on a frame: from the grid's best point alone the fit stayed where a point mass
         # stands for a small J by sliding off the joint (a 0.31 kg block of r 1.6 cm at the
         # portal's corner C: the mass 1.5 cm inside the beam, J 0.1 σ from 0, χ²/n 4.6
-        # against 0.96 with the body on C; a `/tmp` study of 16 corner bodies).  A beam's
-        # fits are as they were (scripts/study_tip_body.py, not run again for this)
+        # against 0.96 with the body on C; scripts/study_frame_body.py).  A beam's fits are
+        # as they were (scripts/study_tip_body.py, not run again for this)
         return model.kind == "frame"
 
     def frame_placeholders(self, model, params):
