@@ -164,6 +164,42 @@ def test_the_frame_campaign_builds_every_class_from_the_exact_frame():
             assert shift > (2 if group == "tension" else 4) * noise, (group, shift, noise)
 
 
+def test_the_frame_body_study_splits_a_member_at_its_body_as_the_model_reads_it():
+    """scripts/study_frame_body.py's exact portal with a body inside a member (the member
+    split there, the body's mass and J on the new joint) and at a corner: the frequencies of
+    the package's portal with the ``attached_body`` on a node of its mesh, at 64 elements a
+    member, within 1e-5 (the mesh's h⁴ error), and a sensor on the split member reads the
+    same mode on both sides of the split."""
+    sys.path.insert(0, str(SCRIPTS))
+    try:
+        import study_frame_body as study
+    finally:
+        sys.path.remove(str(SCRIPTS))
+    from dataclasses import replace
+
+    import numpy as np
+
+    from gfe_opt.frame import frame_modes
+    from gfe_opt.model import Effect
+    from gfe_opt.problems import portal_frame
+
+    model = portal_frame()
+    fine = replace(model, members=tuple(replace(m, elements=64) for m in model.members))
+    for member, at in (("left-column", 0.075), ("beam", 0.4)):
+        exact, where = study._exact_with_body(model, member, at, 0.2, 1.5e-4)
+        body = Effect("attached_body", {"member": member, "position": at, "mass": 0.2,
+                                        "inertia": 1.5e-4})
+        f = frame_modes(fine.with_effects([body]), 6).frequencies_hz
+        truth = np.array([exact.frequency_near(x, 1e-3) for x in f])
+        assert np.max(np.abs(f / truth - 1)) < 1e-5, (member, f / truth - 1)
+        if where is not None:
+            below = where({"member": member, "position": 0.05, "direction": "x"})
+            above = where({"member": member, "position": 0.1, "direction": "x"})
+            assert below == {"member": f"{member}-a", "position": 0.05, "direction": "x"}
+            assert above["member"] == f"{member}-b"
+            assert abs(above["position"] - 0.025) < 1e-12
+
+
 def test_following_the_finishes_changes_no_fit_and_records_what_they_reached():
     """scripts/bench_fit_relevance.py's --campaign follows every Newton finish through a
     proxy of its residual: the diagnosis is the same to the last bit as without it, each
