@@ -1856,11 +1856,8 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
         # (:meth:`~gfe_opt.effects.attached_body.AttachedBody.every_start`); not from the
         # member's whole grid, nor on the members of its length, as ``update --add
         # attached_body:member=...`` fits it: on the three-storey frame that took 30 s
-        groups = []
-        for m, seed in places.items():
-            J = effect_type(BODY).variables(model, {"member": m})[-1]
-            groups.append([{**seed, "member": m, "inertia": J.physical(model, z)}
-                           for z in J.grid])
+        groups = [kind.with_each_inertia(model, {**seed, "member": m})
+                  for m, seed in places.items()]
         bodies = _run_jobs([("group", (model, measured, BODY, noise, group, (), False))
                             for group in groups], None,
                            [f"{BODY} from the point mass"] * len(groups))

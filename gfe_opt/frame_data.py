@@ -389,13 +389,7 @@ def build_observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_mat
             cols += [u, v]
             vals += list(d)
             continue
-        k = member_index[s["member"]]
-        member = model.members[k]
-        L = model.member_length(member) / member.elements
-        j = min(int(s["position"] // L), member.elements - 1)
-        xi = s["position"] / L - j
-        e = int(np.flatnonzero(mesh.element_member == k)[0]) + j
-        T = rotations(mesh.cosines[e:e + 1])[0]       # global -> member axes
+        e, xi, L, T = _element_at(model, mesh, member_index[s["member"]], s["position"])
         R = T[:2, :2]
         local = np.zeros((2, 6))                     # (axial, transverse) from local DOFs
         local[0, [0, 3]] = el.linear(xi)             # axial: u at the ends
@@ -405,6 +399,16 @@ def build_observation(model: FrameModel, mesh: FrameMesh, sensors) -> sp.csr_mat
         cols += mesh.element_dofs[e].tolist()
         vals += row.tolist()
     return sp.csr_matrix((vals, (rows, cols)), shape=(len(sensors), mesh.n_dof))
+
+
+def _element_at(model: FrameModel, mesh: FrameMesh, k: int, position: float):
+    """(the mesh element of member ``k`` that holds ``position`` m from its start, ξ in it,
+    its length, its rotation T from the frame's axes to the member's)."""
+    member = model.members[k]
+    L = model.member_length(member) / member.elements
+    j = min(int(position // L), member.elements - 1)
+    e = int(np.flatnonzero(mesh.element_member == k)[0]) + j
+    return e, position / L - j, L, rotations(mesh.cosines[e:e + 1])[0]
 
 
 def rotation_reading(model: FrameModel, mesh: FrameMesh, places) -> sp.csr_matrix:
@@ -427,11 +431,7 @@ def rotation_reading(model: FrameModel, mesh: FrameMesh, places) -> sp.csr_matri
             vals.append(1.0)
             continue
         k = next(j for j, m in enumerate(model.members) if m.id == member.id)
-        L = length / member.elements
-        j = min(int(x // L), member.elements - 1)
-        xi = x / L - j
-        e = int(np.flatnonzero(mesh.element_member == k)[0]) + j
-        T = rotations(mesh.cosines[e:e + 1])[0]       # global -> member axes
+        e, xi, L, T = _element_at(model, mesh, k, x)
         slope = np.zeros(6)                          # dv/ds from the local DOFs
         slope[[1, 2, 4, 5]] = el.hermite_d1(xi) * el.beam_dof_scaling(L) / L
         rows += [i] * 6

@@ -58,11 +58,13 @@ class AttachedBody(EffectType):
         with each J of the J grid given (:meth:`every_start`: each run to its end)."""
         if model.kind != "frame":
             return POINT_MASS.starts(model, hint)
-        out = []
-        for start in POINT_MASS.starts(model, hint):
-            J = inertia_variable(model.member(start["member"]))
-            out += [start, *({**start, "inertia": J.physical(model, z)} for z in J.grid)]
-        return out
+        return [s for start in POINT_MASS.starts(model, hint)
+                for s in (start, *self.with_each_inertia(model, start))]
+
+    def with_each_inertia(self, model, start: dict) -> list[dict]:
+        """``start`` (on a frame: its member given) with each J of the J grid given."""
+        J = inertia_variable(model.member(start["member"]))
+        return [{**start, "inertia": J.physical(model, z)} for z in J.grid]
 
     def every_start(self, model) -> bool:
         # on a frame: from the grid's best point alone the fit stayed where a point mass

@@ -23,17 +23,9 @@ def inertia_variable(member=None) -> Variable:
     """A body's J in units of ρA L³, from 1e-8 (an accelerometer on a long beam: nothing
     the modes tell) to 1 (a body as heavy as the beam with a radius of gyration as long);
     ``attached_body``'s too.  On a frame, ``member``'s own ρA L³."""
-    if member is None:
-        return Variable("inertia", -8.0, 0.0, (-5.0, -4.0, -3.0, -2.0), log=True,
-                        scale=lambda m: m.rho * m.area * m.length**3)
-    return Variable("inertia", -8.0, 0.0, (-5.0, -4.0, -3.0, -2.0), log=True,
-                    scale=lambda m: member.rho * member.area * m.member_length(member)**3)
-
-
-def frame_body_place(model, member, held) -> Variable:
-    """A body's place along a frame ``member``: its 19 interior places and each end whose
-    node no support holds in every DOF of ``held`` (0 x, 1 y, 2 θ)."""
-    return frame_position_variable(model, member, frame_free_ends(model, member, held))
+    scale = (lambda m: m.rho * m.area * m.length**3) if member is None else \
+        (lambda m: member.rho * member.area * m.member_length(member)**3)
+    return Variable("inertia", -8.0, 0.0, (-5.0, -4.0, -3.0, -2.0), log=True, scale=scale)
 
 
 class RotaryInertia(EffectType):
@@ -70,7 +62,9 @@ class RotaryInertia(EffectType):
         # cantilever) and J
         if model.kind == "frame":
             member = model.member(fixed["member"])
-            return [frame_body_place(model, member, (2,)), inertia_variable(member)]
+            # its 19 interior places and each end no support holds in rotation
+            place = frame_position_variable(model, member, frame_free_ends(model, member, (2,)))
+            return [place, inertia_variable(member)]
         ends = tuple(float(end) for end in (0, 1) if model.supports[end] not in FIXED_ROTATION)
         return [Variable("position", 0.0, 1.0, tuple(np.linspace(0.05, 0.95, 19)) + ends,
                          scale=lambda m: m.length), inertia_variable()]
