@@ -36,7 +36,9 @@ Selection (one procedure; README "Diagnosis" states it with the same numbers)
    a body that turns with the beam (``attached_body``, from the point mass's place) is
    the finding when it ranks first and explains (inside an element: when it does fitted
    again on a mesh with a node by it), with its J :data:`SIZE_SIGMAS` σ from 0
-   (:func:`_body_that_explains`).
+   (:func:`_body_that_explains`); on a frame also where an effect explains, and where
+   the point mass stays the finding, the body's ends that fit as well elsewhere are said
+   (:func:`_turning_elsewhere`).
    If the best does not explain: a pair that explains (estimable) is suggested (of the
    firsts the best does not beat significantly, with the same second, the lowest
    information criterion; :func:`_simplest_first`); else a free profile that explains is
@@ -1089,6 +1091,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
                        shape_correlation(fit.model, measured, noise, C))
         return looks_like_noise(model, fit.misfit, correlation, measured)
 
+    body_ends = []   # the body fit's ends that fit as well as its best (frames)
     if model.kind == "frame" and candidates is None and best is not None and explains(best):
         # on a frame, a significant point mass where an effect explains the data: the mass
         # read again as a body, the finding when it ranks first (selection step 6).  A small
@@ -1099,7 +1102,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
         masses = [f for f in fits if f.name == "point_mass" and not f.failed
                   and f.significant]
         body = _body_that_explains(model, measured, noise, masses, hint, explains,
-                                   ref_misfit) if masses else None
+                                   ref_misfit, body_ends) if masses else None
         if body is not None and _ranks_first(body, fits, sel, reference, material, model):
             best = body
 
@@ -1348,6 +1351,8 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
     if verdict == "effect_found":
         notes += _ambiguities(ranked[0], alike, measured, noise, C, sel,
                               together if suggested and together is not None else None)
+        if not (suggested and together is not None):
+            notes += _turning_elsewhere(ranked[0], body_ends)
     notes += _present_mirrors(reference, measured, noise, C, sel)
     if replace is None and withheld is None and verdict != "effect_found":
         # (with an addition to make, an effect on its edge may be there only while the
@@ -1807,7 +1812,8 @@ def _second_alone(model, measured, noise, C, pair, fits, explains, sel):
 BODY = "attached_body"
 
 
-def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit):
+def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit,
+                        ends=None):
     """Where no candidate explains the data and a point mass was fitted, the mass as a body
     that turns with the beam (``attached_body``: its rotary inertia too), fitted from
     the point mass's place and mass and from its own grid: returned when it explains the
@@ -1821,7 +1827,9 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
     a section loss by the tip that is not there, otherwise).  On a frame it is fitted on
     each mass's member and its mirror image, from the mass's place and mass with each J of
     the grid (``scripts/study_frame_body.py``), and also where an effect explains the data
-    (:func:`_diagnose`); a frame's member is not refined for a body inside an element."""
+    (:func:`_diagnose`); a frame's member is not refined for a body inside an element.
+    ``ends``: a list that receives, on a frame, the body fit's other ends that fit as well
+    as its best (:attr:`~gfe_opt.fitting.Fit.equivalent`, its best's effects first)."""
     kind = effect_type(BODY)
     # any point mass fitted, determined or not (a heavy body on a free end: the point mass
     # alone there, 1.17 kg ± 1.2 for 0.33 kg, left 45 % of the difference, and a spring by
@@ -1864,6 +1872,8 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
         body = bodies[0]
         for fit in bodies[1:]:
             body = fit if _preferred(fit, body) else body
+        if ends is not None and body.success:
+            ends += [body.effects, *body.equivalent]
     else:
         (body,) = _run_jobs([("candidate", (model, measured, BODY, noise, hint, None, (),
                                             seeds))], None, [f"{BODY} from the point mass"])
@@ -1888,6 +1898,40 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
         return None
     return body if again.success and not again.unidentified and explains(again, None) \
         else None
+
+
+def _turning_elsewhere(mass, ends) -> list[Caveat]:
+    """When ``mass`` (the finding) is a point mass on a frame and some of the body fit's
+    ``ends`` (:func:`_body_that_explains`: effect lists that fit as well as its best) put
+    the body more than :data:`SIZE_SIGMAS` σ of the mass's place from it on its member, a
+    caveat: a mass that turns with the member fits as well at places from the mass's to
+    those ends', so the data tell its place no closer than that unless it is known not to
+    turn.  A body of large J inside a column element fits as well as a point
+    mass slid off it, and the mass's σ then says nothing of where the body is (a block of
+    r 4.5 cm at 0.072 m: the point mass at 0.0892 ± 0.0003 m, the body's end at 0.067 m,
+    χ² 71.5 against 70.9 for 90 values; ``scripts/study_frame_body.py`` cases 9108 and
+    9201).  Another effect that fits as well (``alike``): each end's body an alternative,
+    drawn hollow."""
+    if mass.name != "point_mass" or mass.added is None or not ends:
+        return []
+    found = mass.effects[mass.added]
+    x, member = found.parameters["position"], found.parameters["member"]
+    reach = SIZE_SIGMAS * mass.sigma[mass.added].get("position", np.inf)
+    others = [tuple(effects) for effects in ends
+              if effects[-1].name == BODY and effects[-1].parameters["member"] == member
+              and abs(effects[-1].parameters["position"] - x) > reach]
+    if not others:
+        return []
+    bodies = [effects[-1].parameters for effects in others]
+    places = [x, *(b["position"] for b in bodies)]
+    masses = [found.parameters["mass"], *(b["mass"] for b in bodies)]
+    inertia = max(b["inertia"] for b in bodies)
+    return [Caveat(f"a body that turns with {member} (its rotary inertia J, up to "
+                   f"{inertia:.3g} kg m²) fits the data as well as the point mass at places "
+                   f"from {min(places):.4g} to {max(places):.4g} m along it, its mass "
+                   f"{min(masses):.4g} to {max(masses):.4g} kg: unless the mass is known not "
+                   "to turn, the data tell its place no closer than that",
+                   "alike", [(effects[-1],) for effects in others])]
 
 
 def _ranks_first(body, fits, sel, reference, material, model) -> bool:
