@@ -1352,8 +1352,10 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
         notes += _ambiguities(ranked[0], alike, measured, noise, C, sel,
                               together if suggested and together is not None else None)
         if not (suggested and together is not None):
-            notes += _turning_elsewhere(ranked[0], body_ends)
+            notes += _turning_elsewhere(ranked[0], body_ends, measured, noise, C, sel)
     notes += _present_mirrors(reference, measured, noise, C, sel)
+    if candidates is None:
+        notes += _present_turning(model, measured, noise, reference, C, sel)
     if replace is None and withheld is None and verdict != "effect_found":
         # (with an addition to make, an effect on its edge may be there only while the
         # addition is missing: the next diagnosis, after it, judges it)
@@ -1900,38 +1902,76 @@ def _body_that_explains(model, measured, noise, fits, hint, explains, ref_misfit
         else None
 
 
-def _turning_elsewhere(mass, ends) -> list[Caveat]:
-    """When ``mass`` (the finding) is a point mass on a frame and some of the body fit's
-    ``ends`` (:func:`_body_that_explains`: effect lists that fit as well as its best) put
-    the body more than :data:`SIZE_SIGMAS` σ of the mass's place from it on its member, a
-    caveat: a mass that turns with the member fits as well at places from the mass's to
-    those ends', so the data tell its place no closer than that unless it is known not to
-    turn.  A body of large J inside a column element fits as well as a point
-    mass slid off it, and the mass's σ then says nothing of where the body is (a block of
-    r 4.5 cm at 0.072 m: the point mass at 0.0892 ± 0.0003 m, the body's end at 0.067 m,
-    χ² 71.5 against 70.9 for 90 values; ``scripts/study_frame_body.py`` cases 9108 and
-    9201).  Another effect that fits as well (``alike``): each end's body an alternative,
-    drawn hollow."""
-    if mass.name != "point_mass" or mass.added is None or not ends:
+def _turning_elsewhere(fit, ends, measured, noise, C, sel, index=None) -> list[Caveat]:
+    """When ``fit``'s added effect (or its effect ``index``, one the model holds already)
+    is a point mass on a frame and some of a body fit's ``ends`` (effect lists that fit
+    as well as its best: :func:`_body_that_explains`'s, :func:`_present_turning`'s) put
+    the body more than :data:`SIZE_SIGMAS` σ of the mass's place from it on its member,
+    their χ² within :data:`ALIKE_CHI2` noise floors of ``fit``'s, a caveat: a mass that
+    turns with the member fits as well at places from the mass's to those ends', so the
+    data tell its place no closer than that unless it is known not to turn.  A body of
+    large J inside a column element fits as well as a point mass slid off it, and the
+    mass's σ then says nothing of where the body is (a block of r 4.5 cm at 0.072 m: the
+    point mass at 0.0892 ± 0.0003 m, the body's end at 0.067 m, χ² 71.5 against 70.9 for
+    90 values; ``scripts/study_frame_body.py`` cases 9108 and 9201).  Another effect that
+    fits as well (``alike``): each end's body an alternative, drawn hollow (one on a
+    present effect is not drawn, as every caveat on one)."""
+    i = fit.added if index is None else index
+    if i is None or fit.effects[i].name != "point_mass" or not ends:
         return []
-    found = mass.effects[mass.added]
+    found = fit.effects[i]
     x, member = found.parameters["position"], found.parameters["member"]
-    reach = SIZE_SIGMAS * mass.sigma[mass.added].get("position", np.inf)
+    sigma = fit.sigma[i] if i < len(fit.sigma) else {}
+    reach = SIZE_SIGMAS * sigma.get("position", np.inf)
     others = [tuple(effects) for effects in ends
               if effects[-1].name == BODY and effects[-1].parameters["member"] == member
-              and abs(effects[-1].parameters["position"] - x) > reach]
+              and abs(effects[-1].parameters["position"] - x) > reach
+              and misfit(fit.model.with_effects(effects, check=False), measured, noise,
+                         C).chi2 - fit.misfit.chi2 < ALIKE_CHI2 * sel.floor]
     if not others:
         return []
     bodies = [effects[-1].parameters for effects in others]
     places = [x, *(b["position"] for b in bodies)]
     masses = [found.parameters["mass"], *(b["mass"] for b in bodies)]
     inertia = max(b["inertia"] for b in bodies)
+    what = "the point mass" if index is None else f"the present point_mass (effects[{i}])"
     return [Caveat(f"a body that turns with {member} (its rotary inertia J, up to "
-                   f"{inertia:.3g} kg m²) fits the data as well as the point mass at places "
+                   f"{inertia:.3g} kg m²) fits the data as well as {what} at places "
                    f"from {min(places):.4g} to {max(places):.4g} m along it, its mass "
                    f"{min(masses):.4g} to {max(masses):.4g} kg: unless the mass is known not "
                    "to turn, the data tell its place no closer than that",
-                   "alike", [(effects[-1],) for effects in others])]
+                   "alike", [(effects[-1],) for effects in others], index)]
+
+
+def _present_turning(model, measured, noise, reference, C, sel) -> list[Caveat]:
+    """On a frame, each point mass the model holds (``reference``: re-estimated) read as a
+    body that turns, fitted in its place from its place and mass with each J of the grid
+    (the others re-estimated beside it), and the caveat of :func:`_turning_elsewhere` on
+    it: a place an earlier update chose from data that could not tell it from a body's
+    elsewhere stays in doubt at every diagnosis, not only at the one that found it (after
+    ``update --add point_mass``, case 9108's ``consistent`` diagnosis said nothing of it).
+    A body whose best end fits better than the mass is not this caveat's: the
+    ``rotary_inertia`` candidate tries J at the mass."""
+    if model.kind != "frame" or reference is None or not reference.success:
+        return []
+    kind = effect_type(BODY)
+    masses = [i for i, e in enumerate(reference.effects) if e.name == "point_mass"]
+    if not masses:
+        return []
+    jobs = []
+    for i in masses:
+        mass = reference.effects[i]
+        others = model.with_effects([e for j, e in enumerate(reference.effects) if j != i],
+                                    check=False)
+        group = kind.with_each_inertia(others, {k: mass.parameters[k]
+                                                for k in ("member", "position", "mass")})
+        jobs.append(("group", (others, measured, BODY, noise, group, (), False)))
+    notes = []
+    for i, body in zip(masses, _run_jobs(jobs, None, [f"{BODY} at the present mass"] * len(jobs))):
+        if body.success:
+            notes += _turning_elsewhere(reference, [body.effects, *body.equivalent],
+                                        measured, noise, C, sel, i)
+    return notes
 
 
 def _ranks_first(body, fits, sel, reference, material, model) -> bool:
