@@ -1950,8 +1950,9 @@ def _present_turning(model, measured, noise, reference, C, sel) -> list[Caveat]:
     it: a place an earlier update chose from data that could not tell it from a body's
     elsewhere stays in doubt at every diagnosis, not only at the one that found it (after
     ``update --add point_mass``, case 9108's ``consistent`` diagnosis said nothing of it).
-    A body whose best end fits better than the mass is not this caveat's: the
-    ``rotary_inertia`` candidate tries J at the mass."""
+    Not with fewer modes than the body and the others ask (from two frequencies of the
+    portal, a mass's every place fits as well).  A body that fits significantly better
+    than the mass is the ``rotary_inertia`` candidate's to find (J tried at the mass)."""
     if model.kind != "frame" or reference is None or not reference.success:
         return []
     kind = effect_type(BODY)
@@ -1963,6 +1964,10 @@ def _present_turning(model, measured, noise, reference, C, sel) -> list[Caveat]:
         mass = reference.effects[i]
         others = model.with_effects([e for j, e in enumerate(reference.effects) if j != i],
                                     check=False)
+        try:   # (as many modes as the body and the others ask, as for any fit)
+            check_enough_modes(measured, [*others.effects, Effect(BODY, {})])
+        except GfeInputError:
+            return []
         group = kind.with_each_inertia(others, {k: mass.parameters[k]
                                                 for k in ("member", "position", "mass")})
         jobs.append(("group", (others, measured, BODY, noise, group, (), False)))
