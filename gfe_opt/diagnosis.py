@@ -82,6 +82,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import chdtri, ndtri
 
+from .decide import deciding_measurement
 from .effects import candidate_names, effect_type
 from .errors import GfeInputError, GfeSolverError
 from .fitting import (
@@ -259,23 +260,31 @@ class Caveat(str):
     kind: str
     alternatives: tuple
     present: int | None
+    #: the measurement that would tell the finding from its alternative
+    #: (:class:`~gfe_opt.decide.Decision`; None where not computed)
+    decide: object
 
-    def __new__(cls, text: str, kind: str, alternatives=(), present: int | None = None):
+    def __new__(cls, text: str, kind: str, alternatives=(), present: int | None = None,
+                decide=None):
         self = super().__new__(cls, text)
         self.kind = kind
         self.alternatives = tuple(tuple(effects) for effects in alternatives)
         self.present = present
+        self.decide = decide
         return self
 
     def __reduce__(self):
-        return (Caveat, (str(self), self.kind, self.alternatives, self.present))
+        return (Caveat, (str(self), self.kind, self.alternatives, self.present, self.decide))
 
     def to_json(self) -> dict:
         """``{"kind", "note", "alternatives": [[{"effect", "parameters"}, ...], ...],
-        "present"}`` (each alternative as an entry of ``equivalent``)."""
+        "present", "decide"}`` (each alternative as an entry of ``equivalent``; ``decide``
+        the measurement that would tell them apart, :meth:`~gfe_opt.decide.Decision.as_dict`,
+        or null)."""
         return {"kind": self.kind, "note": str(self), "present": self.present,
                 "alternatives": [[{"effect": e.name, "parameters": jsonable(e.parameters)}
-                                  for e in effects] for effects in self.alternatives]}
+                                  for e in effects] for effects in self.alternatives],
+                "decide": None if self.decide is None else self.decide.as_dict()}
 
 
 def caveats_of(notes) -> list[Caveat]:
@@ -393,6 +402,19 @@ class Diagnosis:
             ("mirror", "places", "alike")
         return [e for c in self.caveats if c.kind in kinds and c.present is None
                 for effects in c.alternatives for e in effects]
+
+    @property
+    def deciding_sensors(self) -> list[dict]:
+        """The sensors the caveats' decisions name (:class:`~gfe_opt.decide.Decision`: one
+        more sensor there would tell the finding from what fits as well), each once, as
+        the figures mark them."""
+        out = []
+        for c in self.caveats:
+            d = c.decide
+            if d is not None and d.sensor is not None and d.sensor_sigma > d.threshold \
+                    and d.sensor not in out:
+                out.append(d.sensor)
+        return out
 
     @property
     def current(self) -> Misfit:
@@ -1261,7 +1283,10 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
             notes = [n for n in notes if n not in said
                      and not (isinstance(n, Recommendation) and n.pair)]
             notes.append(_undecided_note(together, undecided, measured, len(model.effects),
-                                         "the pair is not suggested"))
+                                         "the pair is not suggested",
+                                         _decision(together.model, together.model.with_effects(
+                                             undecided[0], check=False), measured, noise, C,
+                                             sel)))
             suggested, together = [], None
     if verdict == "effect_found" and not suggested and measured.frequency_only \
             and not ranked[0].equivalent and ranked[0].added is not None:
@@ -1276,7 +1301,10 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
         undecided = _undetermined(ranked[0], model)
         if undecided:  # parameters the data do not determine: not a finding
             notes.append(_undecided_note(ranked[0], undecided, measured,
-                                         len(model.effects)))
+                                         len(model.effects), decision=_decision(
+                                             ranked[0].model, ranked[0].model.with_effects(
+                                                 undecided[0], check=False), measured, noise,
+                                             C, sel)))
             for f in ranked:
                 f.significant = False
             current = (float("nan") if measured.frequency_only or noise.given else
@@ -1935,12 +1963,18 @@ def _turning_elsewhere(fit, ends, measured, noise, C, sel, index=None) -> list[C
     masses = [found.parameters["mass"], *(b["mass"] for b in bodies)]
     inertia = max(b["inertia"] for b in bodies)
     what = "the point mass" if index is None else f"the present point_mass (effects[{i}])"
+    far = max(others, key=lambda effects: abs(effects[-1].parameters["position"] - x))
+    decision = _decision(fit.model, fit.model.with_effects(far, check=False), measured,
+                         noise, C, sel)
+    tail = "" if decision is None else (
+        f"; between the mass and the body at {far[-1].parameters['position']:.4g} m, "
+        + decision.words())
     return [Caveat(f"a body that turns with {member} (its rotary inertia J, up to "
                    f"{inertia:.3g} kg m²) fits the data as well as {what} at places "
                    f"from {min(places):.4g} to {max(places):.4g} m along it, its mass "
                    f"{min(masses):.4g} to {max(masses):.4g} kg: unless the mass is known not "
-                   "to turn, the data tell its place no closer than that",
-                   "alike", [(effects[-1],) for effects in others], index)]
+                   "to turn, the data tell its place no closer than that" + tail,
+                   "alike", [(effects[-1],) for effects in others], index, decision)]
 
 
 def _present_turning(model, measured, noise, reference, C, sel) -> list[Caveat]:
@@ -2134,6 +2168,13 @@ def _gains(fit) -> bool:
     return fit.success and not fit.failed and fit.gain > fit.threshold
 
 
+def _decision(model_a, model_b, measured, noise, C, sel):
+    """:func:`~gfe_opt.decide.deciding_measurement` between two models that fit alike, at
+    the σ under which the diagnosis calls fits alike (:data:`ALIKE_CHI2` noise floors)."""
+    return deciding_measurement(model_a, model_b, measured, noise,
+                                float(np.sqrt(ALIKE_CHI2 * sel.floor)), C)
+
+
 def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[str]:
     """Sentences for what the data cannot decide: effects that fit as well as the best, and
     (frequencies alone) a local effect's mirror image about mid-span."""
@@ -2142,11 +2183,15 @@ def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[st
         what = "the frequencies" if measured.frequency_only else "the data"
         # with a pair suggested, the comparison is of the effects alone, not of the pair
         alone = "alone, " if together is not None else ""
+        decision = _decision(best.model, alike[0].model, measured, noise, C, sel)
+        tail = (": measure mode shapes to decide" if measured.frequency_only else
+                "" if decision is None else
+                f"; between {best.name} and {alike[0].name}, " + decision.words())
         notes.append(Caveat(f"{alone}{what} cannot tell {best.name} from " + ", ".join(
             f"{f.name} (χ²/n {f.misfit.chi2_per_residual:.3g} against "
-            f"{best.misfit.chi2_per_residual:.3g})" for f in alike)
-            + (": measure mode shapes to decide" if measured.frequency_only else ""),
-            "alike", [(f.effects[-1 if f.added is None else f.added],) for f in alike]))
+            f"{best.misfit.chi2_per_residual:.3g})" for f in alike) + tail,
+            "alike", [(f.effects[-1 if f.added is None else f.added],) for f in alike],
+            decide=decision))
     mirror = _mirror(best, measured, noise, C, sel)
     if mirror is not None:
         notes.append(mirror)
@@ -2358,9 +2403,11 @@ def _mirrored(effects, others, length) -> bool:
 
 
 def _undecided_note(fit, undecided, measured, held,
-                    refused: str = "nothing is suggested") -> Caveat:
+                    refused: str = "nothing is suggested", decision=None) -> Caveat:
     """The finding (the fit's effects after the ``held`` ones of the model), its
-    alternatives and what measurement would decide (``refused``: what is not suggested)."""
+    alternatives and what measurement would decide (``refused``: what is not suggested;
+    ``decision``: :func:`_decision` between the finding and its first alternative, said
+    where the test has shapes)."""
     what = "the frequencies" if measured.frequency_only else "the data"
     alternatives = "; or ".join(", ".join(
         f"{e.name}: {effect_type(e.name).describe(e.parameters)}" for e in effects[held:])
@@ -2371,11 +2418,12 @@ def _undecided_note(fit, undecided, measured, held,
                      for effects in [fit.effects, *undecided] for e in effects[held:]
                      if isinstance(e.parameters.get("position"), (int, float))})
     near = f" near x = {', '.join(f'{x:g}' for x in places)} m" if places else ""
-    decide = ("mode shapes (sensors" + near + ")" if measured.frequency_only
-              else "more modes, or sensors" + (near or " closer together"))
+    decide = ("mode shapes (sensors" + near + ") would decide" if measured.frequency_only
+              else "more modes, or sensors" + (near or " closer together") + " would decide"
+              if decision is None else decision.words())
     return Caveat(f"not a finding: {what} fit {found} as well as {alternatives}, so they "
-                  f"do not determine it; {refused} — {decide} would decide", "undecided",
-                  [effects[held:] for effects in undecided])
+                  f"do not determine it; {refused} — {decide}", "undecided",
+                  [effects[held:] for effects in undecided], decide=decision)
 
 
 def equivalent_notes(fit, measured, told=()) -> list[Caveat]:

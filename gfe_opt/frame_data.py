@@ -643,9 +643,13 @@ def frame_diagnosis_figures(diagnosis, model: FrameModel, title: str, found) -> 
     caveats = diagnosis.caveats
     elsewhere = [_mark(model, e.name, e.parameters) for e in diagnosis.drawn_alternatives
                  if "member" in e.parameters or "node" in e.parameters]
+    deciding = []
+    for sensor in diagnosis.deciding_sensors:
+        point, _ = sensor_places(model, [sensor])
+        deciding.append((tuple(point[0]), sensor_label(sensor)))
     return {"frame_diagnosis.png": plots.frame_findings(members, marks, failing, title,
                                                         [str(c) for c in caveats],
-                                                        elsewhere)}
+                                                        elsewhere, deciding)}
 
 
 def effect_place(model: FrameModel, effect) -> str:

@@ -217,12 +217,13 @@ def paired_frequencies(pairs):
 
 
 def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None, places=(),
-                     findings=(), elsewhere=()):
+                     findings=(), elsewhere=(), deciding=()):
     """The structure as a bar on ``ax`` (x in m): its supports, the sensors, where the model
     fails (``places``: (x, share of the largest residual)), ``findings``: (effect type,
     model, parameters, σ[, parameters on a bound]) each drawn by the effect's own ``mark``,
     and, hollow with "or", where an effect fits as well (``elsewhere``: (x, effect name),
-    the diagnosis's caveats)."""
+    the diagnosis's caveats), and where one more sensor would tell them apart
+    (``deciding``: x, the caveats' decisions)."""
     ax.plot([0, length], [0, 0], lw=6, color="0.4", solid_capstyle="butt")
     if sensors is not None and len(sensors):
         ax.plot(sensors, np.zeros_like(np.asarray(sensors, float)), "|", color="white",
@@ -248,6 +249,11 @@ def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None,
         ax.annotate(f"or {name} here (fits as well)" if k == 0 else f"or {name}", (x, 0.35),
                     textcoords="offset points", xytext=(0, 20 if near else 8), ha="center",
                     fontsize=7, color="0.3")
+    for k, x in enumerate(deciding):
+        ax.plot([x], [-0.35], marker="v", ms=8, mfc="none", mec="tab:blue", mew=1.2)
+        ax.annotate("a sensor here would decide" if k == 0 else "", (x, -0.35),
+                    textcoords="offset points", xytext=(0, -12), ha="center", fontsize=7,
+                    color="tab:blue")
     ax.set_yticks([])
     ax.set_ylim(-1.2, 1.2)
     ax.set_xlim(-0.04 * length, 1.04 * length)
@@ -277,7 +283,8 @@ def localisation(x, residual, comac, length, supports=("pinned", "pinned"), plac
 
 
 def candidate_errors(fits, baseline_pct, together=None, verdict=None, *, length=None,
-                     supports=("pinned", "pinned"), findings=(), elsewhere=(), note=None):
+                     supports=("pinned", "pinned"), findings=(), elsewhere=(), note=None,
+                     deciding=()):
     """Frequency error left by each candidate effect (significant ones coloured) and, when
     a pair is suggested, by the pair (hatched, on top); with ``findings`` and ``elsewhere``
     (as for :func:`structure_sketch`) and the ``length``, the structure with them below;
@@ -315,7 +322,8 @@ def candidate_errors(fits, baseline_pct, together=None, verdict=None, *, length=
         fig.suptitle(_wrapped(f"verdict: {verdict}"), fontsize=10, fontweight="bold")
     ax.legend(fontsize=8)
     if sketch is not None:
-        structure_sketch(sketch, length, supports, findings=findings, elsewhere=elsewhere)
+        structure_sketch(sketch, length, supports, findings=findings, elsewhere=elsewhere,
+                         deciding=deciding)
         sketch.set_xlabel("x [m]: the effects found")
     return fig
 
@@ -631,16 +639,18 @@ FRAME_MARKS = {"crack": ("X", "tab:red"), "joint_spring": ("o", "tab:orange"),
                "member_shear": (None, "tab:pink"), "mass_profile": (None, "tab:purple")}
 
 
-def frame_findings(members, marks, failing, title, caveats=(), elsewhere=()):
+def frame_findings(members, marks, failing, title, caveats=(), elsewhere=(), deciding=()):
     """A frame diagnosis drawn on the frame (grey): the effects found, each numbered at its
     place (``marks``: (effect name, (x, y), label, member polyline or None)) and listed
     with its values below, then ``caveats`` (sentences, in grey: what the data do not
     decide) and, hollow with "or", the places where an effect fits as well (``elsewhere``,
-    as ``marks``), and the sensors where the model as it stands fails most (``failing``:
-    ((x, y), label), hollow circles); titled with the verdict."""
+    as ``marks``), the sensors where the model as it stands fails most (``failing``:
+    ((x, y), label), hollow circles) and where one more sensor would tell the finding from
+    what fits as well (``deciding``: ((x, y), label), the caveats' decisions, hollow
+    triangles); titled with the verdict."""
     import textwrap
 
-    wrapped = [textwrap.fill(c, 120) for c in caveats]
+    wrapped = [textwrap.fill(c, 105) for c in caveats]   # (120 ran past a 6.4 in figure)
     below = [(f"{i}: {label}", FRAME_MARKS.get(name, ("*", "tab:green"))[1], 8)
              for i, (name, _, label, _) in enumerate(marks, 1)] or [("no effect found", "k", 8)]
     below += [(c, "0.35", 7) for c in wrapped]
@@ -671,6 +681,13 @@ def frame_findings(members, marks, failing, title, caveats=(), elsewhere=()):
                    edgecolors=colour, linewidths=1.2, zorder=4)
         ax.annotate(f"or {name}", (x, y), fontsize=7, color=colour, xytext=(7, -10),
                     textcoords="offset points", zorder=5)
+    for i, ((x, y), label) in enumerate(deciding):
+        ax.scatter([x], [y], marker="v", s=80, facecolors="none", edgecolors="tab:blue",
+                   linewidths=1.2, zorder=4,
+                   label="one more sensor here would decide (the notes below)" if i == 0
+                   else None)
+        ax.annotate(label, (x, y), fontsize=6.5, color="tab:blue", xytext=(0, -14),
+                    textcoords="offset points", ha="center")
     if elsewhere:   # one legend entry for them all, whatever their markers
         ax.scatter([], [], marker="o", s=90, facecolors="none", edgecolors="0.3",
                    linewidths=1.2, label='hollow, "or": fits as well (the notes below)')
@@ -679,8 +696,10 @@ def frame_findings(members, marks, failing, title, caveats=(), elsewhere=()):
         listing.text(0.0, 1.0 - row / lines, text, fontsize=size, color=colour, va="top",
                      transform=listing.transAxes)
         row += text.count("\n") + 1
-    if failing or elsewhere:
-        ax.legend(fontsize=7, loc="upper right", bbox_to_anchor=(1.0, 1.12), frameon=False)
+    entries = sum(map(bool, (failing, elsewhere, deciding)))
+    if entries:   # above the frame, the title above it
+        ax.legend(fontsize=7, loc="lower right", bbox_to_anchor=(1.0, 1.0), frameon=False)
     ax.margins(0.12)
-    ax.set_title(_wrapped(title), fontsize=10, fontweight="bold", loc="left")
+    ax.set_title(_wrapped(title), fontsize=10, fontweight="bold", loc="left",
+                 pad=6 + 11 * entries)
     return fig

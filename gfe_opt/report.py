@@ -51,6 +51,12 @@ def elsewhere(diagnosis) -> list:
     return out
 
 
+def deciding(diagnosis) -> list:
+    """Where on a beam or bar one more sensor would tell the finding from what fits as well
+    (:attr:`~gfe_opt.diagnosis.Diagnosis.deciding_sensors`), as x."""
+    return [float(s["x"]) for s in diagnosis.deciding_sensors if "x" in s]
+
+
 def verdict_title(diagnosis) -> str:
     """``crack missing`` (with what the text says remains after it, ``crack missing; a
     difference remains after it: χ²/n 8.2, ...``), else the verdict in the words the text
@@ -90,7 +96,8 @@ def line_diagnosis_figures(diagnosis, model) -> dict:
     figs = {"candidates.png": plots.candidate_errors(
         diagnosis.fits, diagnosis.current.freq_error_rms_pct, diagnosis.together,
         verdict=verdict_title(diagnosis), length=model.length, supports=model.supports,
-        findings=found, elsewhere=elsewhere(diagnosis), note=withheld_title(diagnosis))} \
+        findings=found, elsewhere=elsewhere(diagnosis), note=withheld_title(diagnosis),
+        deciding=deciding(diagnosis))} \
         if diagnosis.fits else {}
     band = diagnosis.profile_band
     best = diagnosis.best

@@ -1444,13 +1444,16 @@ def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
     from types import SimpleNamespace
 
     from gfe_opt import plots
+    from gfe_opt.decide import Decision
     from gfe_opt.diagnosis import Caveat, Diagnosis
     from gfe_opt.frame_data import frame_diagnosis_figures
 
     said = {}
     monkeypatch.setattr(plots, "frame_findings",
-                        lambda members, marks, failing, title, caveats=(), elsewhere=():
-                        said.update(caveats=list(caveats), elsewhere=list(elsewhere)))
+                        lambda members, marks, failing, title, caveats=(), elsewhere=(),
+                        deciding=(): said.update(caveats=list(caveats),
+                                                 elsewhere=list(elsewhere),
+                                                 deciding=list(deciding)))
     crack = Effect("crack", {"member": "beam", "position": 0.3038, "depth_ratio": 0.3})
     notes = ["joint_spring with a further joint_spring brings the misfit to the noise",
              Caveat("the data fix the sum of the two joint_springs' stiffness, 4007 ± 43 "
@@ -1462,9 +1465,12 @@ def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
              Caveat("the crack on beam at 0.0962 m fits as well at its mirror image, beam "
                     "at 0.3038 m: the frequencies cannot tell the two places apart",
                     "mirror", [[crack]]),
-             Caveat("alone, the frequencies cannot tell joint_spring from point_mass",
+             Caveat("alone, the data cannot tell joint_spring from point_mass; ... a "
+                    "sensor on beam at 0.2 m, direction y would see them differ by 5.0 σ",
                     "alike", [[Effect("point_mass", {"member": "beam", "position": 0.0,
-                                                     "mass": 0.05})]]),
+                                                     "mass": 0.05})]],
+                    decide=Decision({"member": "beam", "position": 0.2, "direction": "y"},
+                                    5.0, None, None, 0.0, 2.0)),
              Caveat("the present crack (effects[0]) on beam at 0.1 m fits as well at its "
                     "mirror image, beam at 0.3 m", "mirror",
                     [[Effect("crack", {"member": "beam", "position": 0.3,
@@ -1474,6 +1480,7 @@ def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
     class StandIn(SimpleNamespace):   # a diagnosis of these notes, as the figure reads it
         caveats = Diagnosis.caveats
         drawn_alternatives = Diagnosis.drawn_alternatives
+        deciding_sensors = Diagnosis.deciding_sensors
 
     stand_in = StandIn(notes=notes, localisation=[], together=None)
     portal = portal_frame()
@@ -1488,6 +1495,11 @@ def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
     t = 0.3038 / portal.member_length(beam)
     assert name == "crack" and np.allclose((x, y), (x0 + t * (x1 - x0), y0 + t * (y1 - y0)))
     assert other == "point_mass"
+    # the sensor the alike caveat's decision names, marked where it would be and named
+    (((x, y), label),) = said["deciding"]
+    t = 0.2 / portal.member_length(beam)
+    assert label == "beam at 0.2 m, y"
+    assert np.allclose((x, y), (x0 + t * (x1 - x0), y0 + t * (y1 - y0)))
     # with a pair suggested, an effect alike to its first one alone is no place of the pair
     stand_in.together = object()
     frame_diagnosis_figures(stand_in, portal, "title", [])
