@@ -21,7 +21,7 @@ The separation is said in σ with the place (or mode) where it is largest.  It t
 two models apart when its square exceeds :data:`~gfe_opt.diagnosis.ALIKE_CHI2`, the χ² gap
 under which the diagnosis calls two fits alike: a reading that moves their χ² further apart
 than that would make the diagnosis choose.  Where no place and no next mode does, that is
-said instead (repeated tests, less noise, would).  A prediction of the models, not of the
+said instead, with the best σ and the σ needed.  A prediction of the models, not of the
 structure: it is as right as the two models are.
 """
 
@@ -79,8 +79,7 @@ class Decision:
             return " or ".join(parts) + " (the two models' prediction)"
         best = max(self.sensor_sigma, self.mode_sigma)
         return (f"no one more sensor and none of the next {NEXT_MODES} modes would tell them "
-                f"apart (at best {best:.1f} σ, {self.threshold:.2f} needed): only less noise "
-                "would")
+                f"apart (at best {best:.1f} σ, {self.threshold:.2f} needed)")
 
 
 def _place_words(sensor: dict) -> str:
