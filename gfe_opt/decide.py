@@ -21,8 +21,10 @@ The separation is said in σ with the place (or mode) where it is largest.  It t
 two models apart when its square exceeds :data:`~gfe_opt.diagnosis.ALIKE_CHI2`, the χ² gap
 under which the diagnosis calls two fits alike: a reading that moves their χ² further apart
 than that would make the diagnosis choose.  Where no place and no next mode does, that is
-said instead, with the best σ and the σ needed.  A prediction of the models, not of the
-structure: it is as right as the two models are.
+said instead, with the best σ and the σ needed.  A prediction of the two fits as they
+stand, not of the structure, and before either is refitted with the new reading: refitted,
+they may move closer (the portal's body of ``scripts/study_frame_body.py`` case 9201 needed
+the sensor said, then the one said next).
 """
 
 from __future__ import annotations
@@ -76,7 +78,8 @@ class Decision:
             parts.append(f"mode {self.mode} (about {self.mode_hz:.4g} Hz) would differ by "
                          f"{self.mode_sigma:.1f} σ in frequency")
         if parts:
-            return " or ".join(parts) + " (the two models' prediction)"
+            return (" or ".join(parts) + " (the two fits' prediction as they stand: refitted "
+                    "with the new reading they may move closer)")
         best = max(self.sensor_sigma, self.mode_sigma)
         return (f"no one more sensor and none of the next {NEXT_MODES} modes would tell them "
                 f"apart (at best {best:.1f} σ, {self.threshold:.2f} needed)")

@@ -2228,7 +2228,7 @@ def _other_places(fit, measured, noise, C, sel, together=None) -> Caveat | None:
     taken = {effect_place(model, e) for e in (together.effects if together else ())
              if e.name == fit.name}
     mine = residuals(model, measured, noise, C)[0]
-    alike = {}
+    alike, first = {}, None   # (first: the effects of the best place that fits as well)
     for effects, chi2 in sorted(fit.other_places, key=lambda item: item[1]):
         place = effect_place(model, effects[fit.added])
         if place == here or place in alike or place in taken:
@@ -2241,14 +2241,20 @@ def _other_places(fit, measured, noise, C, sel, together=None) -> Caveat | None:
                 < SEPARATION * sel.floor
         if close:
             alike[place] = (chi2, effects[fit.added])
+            first = effects if first is None else first
     if not alike:
         return None
     n = max(fit.misfit.n_residuals, 1)
     what = "frequencies" if measured.frequency_only else "data"
+    decision = _decision(model, model.with_effects(list(first), check=False), measured,
+                         noise, C, sel)
+    tail = "" if decision is None else (f"; between {here} and {next(iter(alike))}, "
+                                        + decision.words())
     return Caveat(f"the {fit.name} at {here} may as well be at " + ", ".join(
         f"{place} (χ²/n {chi2 / n:.3g} against {fit.misfit.chi2_per_residual:.3g})"
         for place, (chi2, _) in alike.items()) + f": the {what} cannot tell these places "
-        "apart", "places", [(effect,) for _, effect in alike.values()])
+        "apart" + tail, "places", [(effect,) for _, effect in alike.values()],
+        decide=decision)
 
 
 def _other_end(effects, chi2, other, sel) -> bool:

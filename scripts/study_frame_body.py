@@ -72,13 +72,16 @@ def case(seed: int, k: int) -> dict:
     sensors = _sensors(model)
     measured = _measured(model, exact, _guess(model, [truth]), sensors, seed, where=where)
     start = time.perf_counter()
-    verdicts, added, notes, fit, said = [], [], [], None, []
+    verdicts, added, notes, fit, said, deciding = [], [], [], None, [], []
     for _ in range(STEPS):
         d = diagnose(model, measured, **STATED)
         verdicts.append(d.verdict)
         notes += [n for n in d.notes if "cannot tell these places apart" in n]
-        said += [e for c in d.caveats if c.kind == "alike"
-                 for effects in c.alternatives for e in effects if e.name == "attached_body"]
+        turning = [c for c in d.caveats if c.kind == "alike" and any(
+            e.name == "attached_body" for effects in c.alternatives for e in effects)]
+        said += [e for c in turning for effects in c.alternatives for e in effects
+                 if e.name == "attached_body"]
+        deciding += [c.decide.as_dict() for c in turning if c.decide is not None]
         if d.verdict != "effect_found":
             break
         added += list(d.suggested)
@@ -129,7 +132,8 @@ def case(seed: int, k: int) -> dict:
             "found_places": places, "right": bool(right), "mirror_said": bool(mirror),
             "inertia_untold": untold, "inertia_within_3_sigma": bool(loose),
             "body_said_alike": body_said, "bodies_said": len(said),
-            "seconds": time.perf_counter() - start}
+            # what those caveats said would tell the mass from the body (JSON ``decide``)
+            "deciding": deciding, "seconds": time.perf_counter() - start}
 
 
 def main() -> None:

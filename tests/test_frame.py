@@ -1438,7 +1438,8 @@ def test_mirror_members_of_symmetric_and_unsymmetric_frames():
 def test_the_frame_figure_repeats_what_the_data_do_not_decide(monkeypatch):
     """The figure of a frame diagnosis lists under its findings the diagnosis's caveats
     (a sum told and not its split, another assignment, a mirror place that fits as well),
-    in their own words, and draws where the finding fits as well; a note that merely
+    in their own words, draws where the finding fits as well and marks the sensor a
+    caveat's decision names where it would be; a note that merely
     sounds like one (a plain sentence with the same words) is not listed: the figure reads
     the caveats' kinds, not their words."""
     from types import SimpleNamespace
