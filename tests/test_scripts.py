@@ -287,3 +287,36 @@ def test_bench_realisation_scores_the_words_on_truths_the_package_did_not_build(
         assert row["features"][0]["shown_by_finding"] is True, row["name"]
     card = doc["scorecard"]
     assert card["linear"] == card["all"] and card["all"]["spurious"] <= 1
+
+
+def test_bench_compares_jacobians_on_fits_both_sides_converged():
+    """``scripts/bench.py --parts fits`` compares each fit of the analytic side with its
+    namesake of the difference side; a fit whose two ends lie in different valleys (χ² 419
+    after IPOPT's iteration limit where the other path reached 309: the real cantilever's
+    section loss) or that a side left unconverged measures the paths' stopping, not the
+    Jacobians: listed apart with both ends; the differences are those of the fits that
+    both paths took to one end."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("bench", SCRIPTS / "bench.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    a = {"fits": [("d/crack", [0.19, 0.5], [1e-3, 1e-2], 100.0, "converged", True),
+                  ("d/section_loss", [0.19, 0.38], [0.01, 0.02], 419.0,
+                   "Maximum_Iterations_Exceeded", True),
+                  ("d/shear", [1e5], [1e3], 90.0, "Maximum_Iterations_Exceeded", False),
+                  ("d/foundation (failed)", [], [], float("nan"), "converged", True)]}
+    b = {"fits": [("d/crack", [0.19 * (1 + 2e-7), 0.5], [1e-3, 1e-2], 100.0 * (1 + 1e-10),
+                   "converged", True),
+                  ("d/section_loss", [0.52, 0.49], [0.01, 0.02], 309.0, "converged", True),
+                  ("d/shear", [1.1e5], [1e3], 90.0, "converged", True),
+                  ("d/foundation (failed)", [], [], float("nan"), "converged", True)]}
+    out = bench._fit_differences(a, b)
+    assert out["fits_compared"] == 2   # the crack, and the failed foundation (no values)
+    assert out["max_parameter_rel_difference"] == pytest.approx(2e-7, rel=1e-3)
+    assert out["max_chi2_rel_difference"] == pytest.approx(1e-10, rel=1e-3)
+    assert out["fits_ended_apart"] == [
+        {"fit": "d/section_loss", "status": ["Maximum_Iterations_Exceeded", "converged"],
+         "chi2": [419.0, 309.0]},
+        {"fit": "d/shear", "status": ["Maximum_Iterations_Exceeded", "converged"],
+         "chi2": [90.0, 90.0]}]
