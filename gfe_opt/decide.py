@@ -1,7 +1,8 @@
 r"""What measurement would tell two models apart that fit the test alike.
 
 When the diagnosis says the data cannot tell a finding from an alternative (a caveat of kind
-``alike`` or ``undecided``), the engineer's next question is what to measure.  Both models
+``alike``, the turning body on a frame included, ``places`` on a frame, or ``undecided``),
+the engineer's next question is what to measure.  Both models
 are fitted to the same test, so at its sensors they read alike; elsewhere they need not.
 :func:`deciding_measurement` predicts, from the two models themselves, the reading of one
 more sensor at every place of a grid over the structure (a beam: :data:`BEAM_PLACES`
@@ -18,9 +19,10 @@ own noise:
 * the next mode k (above those measured): :math:`|f_{a,k} / f_{b,k} - 1| / σ_f`.
 
 The separation is said in σ with the place (or mode) where it is largest.  It tells the
-two models apart when its square exceeds :data:`~gfe_opt.diagnosis.ALIKE_CHI2`, the χ² gap
-under which the diagnosis calls two fits alike: a reading that moves their χ² further apart
-than that would make the diagnosis choose.  Where no place and no next mode does, that is
+two models apart when its square exceeds :data:`~gfe_opt.diagnosis.ALIKE_CHI2` noise floors
+(the diagnosis's threshold, √(ALIKE_CHI2 × floor)), the χ² gap under which the diagnosis
+calls two fits alike: a reading that moves their χ² further apart than that would make the
+diagnosis choose.  Where no place and no next mode does, that is
 said instead, with the best σ and the σ needed.  A prediction of the two fits as they
 stand, not of the structure, and before either is refitted with the new reading: refitted,
 they may move closer (the portal's body of ``scripts/study_frame_body.py`` case 9201 needed
@@ -45,7 +47,8 @@ NEXT_MODES = 3
 class Decision:
     """The measurement that best tells two models apart: ``sensor`` (a beam: ``{"x": m,
     "dof": ...}``; a frame: a sensor of the frame contract) with ``sensor_sigma``, and the
-    next mode ``mode`` (1-based, as counted by the model; None when none was computed) at
+    next mode ``mode`` (1-based, counted from the first elastic mode; None when none was
+    computed) at
     ``mode_hz`` with ``mode_sigma``; ``threshold`` the σ that decides."""
 
     sensor: dict | None
