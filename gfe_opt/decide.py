@@ -59,8 +59,16 @@ class Decision:
     threshold: float
 
     @property
+    def sensor_decides(self) -> bool:
+        return self.sensor is not None and bool(self.sensor_sigma > self.threshold)
+
+    @property
+    def mode_decides(self) -> bool:
+        return self.mode is not None and bool(self.mode_sigma > self.threshold)
+
+    @property
     def decides(self) -> bool:
-        return bool(max(self.sensor_sigma, self.mode_sigma) > self.threshold)
+        return self.sensor_decides or self.mode_decides
 
     def as_dict(self) -> dict:
         """The ``decide`` object of a caveat in ``diagnose --json`` (README, Diagnosis)."""
@@ -74,10 +82,10 @@ class Decision:
     def words(self) -> str:
         """The clause a caveat ends with."""
         parts = []
-        if self.sensor is not None and self.sensor_sigma > self.threshold:
+        if self.sensor_decides:
             parts.append(f"a sensor {_place_words(self.sensor)} would see them differ by "
                          f"{self.sensor_sigma:.1f} σ of the shape noise")
-        if self.mode is not None and self.mode_sigma > self.threshold:
+        if self.mode_decides:
             parts.append(f"mode {self.mode} (about {self.mode_hz:.4g} Hz) would differ by "
                          f"{self.mode_sigma:.1f} σ in frequency")
         if parts:

@@ -411,8 +411,7 @@ class Diagnosis:
         out = []
         for c in self.caveats:
             d = c.decide
-            if d is not None and d.sensor is not None and d.sensor_sigma > d.threshold \
-                    and d.sensor not in out:
+            if d is not None and d.sensor_decides and d.sensor not in out:
                 out.append(d.sensor)
         return out
 
@@ -1283,10 +1282,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
             notes = [n for n in notes if n not in said
                      and not (isinstance(n, Recommendation) and n.pair)]
             notes.append(_undecided_note(together, undecided, measured, len(model.effects),
-                                         "the pair is not suggested",
-                                         _decision(together.model, together.model.with_effects(
-                                             undecided[0], check=False), measured, noise, C,
-                                             sel)))
+                                         (noise, C, sel), "the pair is not suggested"))
             suggested, together = [], None
     if verdict == "effect_found" and not suggested and measured.frequency_only \
             and not ranked[0].equivalent and ranked[0].added is not None:
@@ -1301,10 +1297,7 @@ def _diagnose(model, measured, candidates, freq_noise, shape_noise, progress, re
         undecided = _undetermined(ranked[0], model)
         if undecided:  # parameters the data do not determine: not a finding
             notes.append(_undecided_note(ranked[0], undecided, measured,
-                                         len(model.effects), decision=_decision(
-                                             ranked[0].model, ranked[0].model.with_effects(
-                                                 undecided[0], check=False), measured, noise,
-                                             C, sel)))
+                                         len(model.effects), (noise, C, sel)))
             for f in ranked:
                 f.significant = False
             current = (float("nan") if measured.frequency_only or noise.given else
@@ -1966,9 +1959,8 @@ def _turning_elsewhere(fit, ends, measured, noise, C, sel, index=None) -> list[C
     far = max(others, key=lambda effects: abs(effects[-1].parameters["position"] - x))
     decision = _decision(fit.model, fit.model.with_effects(far, check=False), measured,
                          noise, C, sel)
-    tail = "" if decision is None else (
-        f"; between the mass and the body at {far[-1].parameters['position']:.4g} m, "
-        + decision.words())
+    tail = _between(decision, "the mass",
+                    f"the body at {far[-1].parameters['position']:.4g} m")
     return [Caveat(f"a body that turns with {member} (its rotary inertia J, up to "
                    f"{inertia:.3g} kg m²) fits the data as well as {what} at places "
                    f"from {min(places):.4g} to {max(places):.4g} m along it, its mass "
@@ -2175,6 +2167,12 @@ def _decision(model_a, model_b, measured, noise, C, sel):
                                 float(np.sqrt(ALIKE_CHI2 * sel.floor)), C)
 
 
+def _between(decision, a: str, b: str) -> str:
+    """The clause a caveat ends with: what would tell ``a`` from ``b`` (none without a
+    decision)."""
+    return "" if decision is None else f"; between {a} and {b}, " + decision.words()
+
+
 def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[str]:
     """Sentences for what the data cannot decide: effects that fit as well as the best, and
     (frequencies alone) a local effect's mirror image about mid-span."""
@@ -2185,8 +2183,7 @@ def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[st
         alone = "alone, " if together is not None else ""
         decision = _decision(best.model, alike[0].model, measured, noise, C, sel)
         tail = (": measure mode shapes to decide" if measured.frequency_only else
-                "" if decision is None else
-                f"; between {best.name} and {alike[0].name}, " + decision.words())
+                _between(decision, best.name, alike[0].name))
         notes.append(Caveat(f"{alone}{what} cannot tell {best.name} from " + ", ".join(
             f"{f.name} (χ²/n {f.misfit.chi2_per_residual:.3g} against "
             f"{best.misfit.chi2_per_residual:.3g})" for f in alike) + tail,
@@ -2248,8 +2245,7 @@ def _other_places(fit, measured, noise, C, sel, together=None) -> Caveat | None:
     what = "frequencies" if measured.frequency_only else "data"
     decision = _decision(model, model.with_effects(list(first), check=False), measured,
                          noise, C, sel)
-    tail = "" if decision is None else (f"; between {here} and {next(iter(alike))}, "
-                                        + decision.words())
+    tail = _between(decision, here, next(iter(alike)))
     return Caveat(f"the {fit.name} at {here} may as well be at " + ", ".join(
         f"{place} (χ²/n {chi2 / n:.3g} against {fit.misfit.chi2_per_residual:.3g})"
         for place, (chi2, _) in alike.items()) + f": the {what} cannot tell these places "
@@ -2408,12 +2404,14 @@ def _mirrored(effects, others, length) -> bool:
     return True
 
 
-def _undecided_note(fit, undecided, measured, held,
-                    refused: str = "nothing is suggested", decision=None) -> Caveat:
+def _undecided_note(fit, undecided, measured, held, judged,
+                    refused: str = "nothing is suggested") -> Caveat:
     """The finding (the fit's effects after the ``held`` ones of the model), its
     alternatives and what measurement would decide (``refused``: what is not suggested;
-    ``decision``: :func:`_decision` between the finding and its first alternative, said
-    where the test has shapes)."""
+    ``judged``: (noise, C, selection) of :func:`_decision` between the finding and its
+    first alternative, said where the test has shapes)."""
+    decision = _decision(fit.model, fit.model.with_effects(undecided[0], check=False),
+                         measured, *judged)
     what = "the frequencies" if measured.frequency_only else "the data"
     alternatives = "; or ".join(", ".join(
         f"{e.name}: {effect_type(e.name).describe(e.parameters)}" for e in effects[held:])
