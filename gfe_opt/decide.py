@@ -8,7 +8,7 @@ are fitted to the same test, so at its sensors they read alike; elsewhere they n
 more sensor at every place of a grid over the structure (a beam: :data:`BEAM_PLACES`
 places along it, the test's direction; a frame: :data:`MEMBER_PLACES` places along each
 member, in x and in y) and the frequencies of the next modes, each in units of the test's
-own noise:
+own noise (a test of frequencies alone: the next modes only):
 
 * a sensor at place p: the square root of the χ² that model a would gain, over the modes
   the test paired in both, if model b were right and the test had the sensor at p: the
@@ -92,8 +92,11 @@ class Decision:
             return (" or ".join(parts) + " (the two fits' prediction as they stand: refitted "
                     "with the new reading they may move closer)")
         best = max(self.sensor_sigma, self.mode_sigma)
-        return (f"no one more sensor and none of the next {NEXT_MODES} modes would tell them "
-                f"apart (at best {best:.1f} σ, {self.threshold:.2f} needed)")
+        what = (f"no one more sensor and none of the next {NEXT_MODES} modes"
+                if self.sensor is not None else
+                f"none of the next {NEXT_MODES} modes' frequencies")
+        return (f"{what} would tell them apart (at best {best:.1f} σ, "
+                f"{self.threshold:.2f} needed)")
 
 
 def _place_words(sensor: dict) -> str:
@@ -106,19 +109,17 @@ def _place_words(sensor: dict) -> str:
 def deciding_measurement(model_a, model_b, measured, noise, threshold: float,
                          C=None) -> Decision | None:
     """The :class:`Decision` between two models fitted to ``measured`` (module docstring);
-    None where either cannot be evaluated or the test has no shapes."""
+    None where either cannot be evaluated.  A test of frequencies alone: the next modes
+    only (``sensor`` None: one more sensor reads no shape where none was measured)."""
     from .fitting import evaluate
 
-    if measured.frequency_only:
-        return None
     a = evaluate(model_a, measured, noise, C)
     b = evaluate(model_b, measured, noise, C)
     if a is None or b is None:
         return None
-    grid = _grid(model_a, measured)
     sensor, sensor_sigma = None, 0.0
-    if grid is not None and len(a.rows) and len(b.rows):
-        places, probe = grid
+    if not measured.frequency_only and len(a.rows) and len(b.rows):
+        places, probe = _grid(model_a, measured)
         ca, cb = a.disc.observation(probe), b.disc.observation(probe)
         total = np.zeros(len(places))
         for i, (row, ja) in enumerate(zip(a.rows, a.cols)):

@@ -1960,7 +1960,8 @@ def _turning_elsewhere(fit, ends, measured, noise, C, sel, index=None) -> list[C
     decision = _decision(fit.model, fit.model.with_effects(far, check=False), measured,
                          noise, C, sel)
     tail = _between(decision, "the mass",
-                    f"the body at {far[-1].parameters['position']:.4g} m")
+                    f"the body at {far[-1].parameters['position']:.4g} m") + _shapes_tail(
+        decision, measured)
     return [Caveat(f"a body that turns with {member} (its rotary inertia J, up to "
                    f"{inertia:.3g} kg m²) fits the data as well as {what} at places "
                    f"from {min(places):.4g} to {max(places):.4g} m along it, its mass "
@@ -2173,6 +2174,15 @@ def _between(decision, a: str, b: str) -> str:
     return "" if decision is None else f"; between {a} and {b}, " + decision.words()
 
 
+def _shapes_tail(decision, measured) -> str:
+    """After :func:`_between` on a test of frequencies alone: mode shapes, the other
+    measurement (its decision weighs the next modes' frequencies only)."""
+    if not measured.frequency_only:
+        return ""
+    return "; or measure mode shapes" if decision is not None and decision.decides else \
+        ": measure mode shapes to decide"
+
+
 def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[str]:
     """Sentences for what the data cannot decide: effects that fit as well as the best, and
     (frequencies alone) a local effect's mirror image about mid-span."""
@@ -2182,8 +2192,8 @@ def _ambiguities(best, alike, measured, noise, C, sel, together=None) -> list[st
         # with a pair suggested, the comparison is of the effects alone, not of the pair
         alone = "alone, " if together is not None else ""
         decision = _decision(best.model, alike[0].model, measured, noise, C, sel)
-        tail = (": measure mode shapes to decide" if measured.frequency_only else
-                _between(decision, best.name, alike[0].name))
+        tail = _between(decision, best.name, alike[0].name) + _shapes_tail(decision,
+                                                                          measured)
         notes.append(Caveat(f"{alone}{what} cannot tell {best.name} from " + ", ".join(
             f"{f.name} (χ²/n {f.misfit.chi2_per_residual:.3g} against "
             f"{best.misfit.chi2_per_residual:.3g})" for f in alike) + tail,
@@ -2245,7 +2255,7 @@ def _other_places(fit, measured, noise, C, sel, together=None) -> Caveat | None:
     what = "frequencies" if measured.frequency_only else "data"
     decision = _decision(model, model.with_effects(list(first), check=False), measured,
                          noise, C, sel)
-    tail = _between(decision, here, next(iter(alike)))
+    tail = _between(decision, here, next(iter(alike))) + _shapes_tail(decision, measured)
     return Caveat(f"the {fit.name} at {here} may as well be at " + ", ".join(
         f"{place} (χ²/n {chi2 / n:.3g} against {fit.misfit.chi2_per_residual:.3g})"
         for place, (chi2, _) in alike.items()) + f": the {what} cannot tell these places "
@@ -2422,9 +2432,12 @@ def _undecided_note(fit, undecided, measured, held, judged,
                      for effects in [fit.effects, *undecided] for e in effects[held:]
                      if isinstance(e.parameters.get("position"), (int, float))})
     near = f" near x = {', '.join(f'{x:g}' for x in places)} m" if places else ""
-    decide = ("mode shapes (sensors" + near + ") would decide" if measured.frequency_only
-              else "more modes, or sensors" + (near or " closer together") + " would decide"
-              if decision is None else decision.words())
+    shapes = "mode shapes (sensors" + near + ") would decide"
+    decide = ("more modes, or sensors" + (near or " closer together") + " would decide"
+              if decision is None and not measured.frequency_only else shapes
+              if decision is None else decision.words() + (
+                  ("; or " if decision.decides else "; ") + shapes
+                  if measured.frequency_only else ""))
     return Caveat(f"not a finding: {what} fit {found} as well as {alternatives}, so they "
                   f"do not determine it; {refused} — {decide}", "undecided",
                   [effects[held:] for effects in undecided], decide=decision)

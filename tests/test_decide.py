@@ -11,6 +11,7 @@ import pytest
 from gfe_opt.decide import deciding_measurement
 from gfe_opt.fitting import Noise, evaluate, misfit
 from gfe_opt.frame_data import frame_measured_from_dict
+from gfe_opt.measured import make_measured
 from gfe_opt.model import Effect, load_model
 from gfe_opt.problems import portal_frame, problem_file
 from gfe_opt.synthetic import synthetic_measurement
@@ -119,3 +120,35 @@ def test_one_more_sensor_on_a_frame_opens_the_gap_the_decision_says():
 
     d = _check_sensor(a, b, measured, extended)
     assert d.sensor["member"] == "left-column"
+
+
+def test_from_frequencies_alone_the_next_mode_opens_the_gap_the_decision_says():
+    """A test of five frequencies (no shapes) of the pinned–pinned steel beam with a crack at
+    0.62 L, from a finer mesh; the two models: a crack at 0.6 L and a point mass at 0.6 L.
+    No sensor is proposed (there are no shapes to add one to); the next mode said, measured
+    as model b has it, opens the χ² gap between the two models by the σ² said, and the words
+    name only modes."""
+    model = load_model(problem_file("ss-steel-beam.toml"))
+    L = model.length
+    data_model = model.with_effects([Effect("crack", {"position": 0.62 * L,
+                                                      "depth_ratio": 0.4})])
+    shaped = synthetic_measurement(data_model, 5, np.linspace(0.1, 0.9, 9) * L,
+                                   shape_noise=0.003, freq_noise=0.0005, seed=12,
+                                   reference_elements=4 * model.elements)
+    measured = make_measured([], "w", shaped.frequencies_hz, None, "frequencies")
+    assert measured.frequency_only
+    a = model.with_effects([Effect("crack", {"position": 0.6 * L, "depth_ratio": 0.4})])
+    b = model.with_effects([Effect("point_mass", {"position": 0.6 * L,
+                                                  "mass": 0.03 * model.rho * model.area * L})])
+    d = deciding_measurement(a, b, measured, NOISE, threshold=2.0)
+    assert d is not None and d.sensor is None and d.sensor_sigma == 0.0
+    assert d.mode > measured.n_modes
+    fb = evaluate(b, measured, NOISE).modes.frequencies_hz
+    more = make_measured([], "w", np.append(measured.frequencies_hz, fb[d.mode - 1]),
+                         None, "one more mode")
+    grown = _gap(a, b, more) - _gap(a, b, measured)
+    assert grown == pytest.approx(d.mode_sigma**2, rel=1e-6), (d, grown)
+    assert "sensor" not in d.words()
+    never = deciding_measurement(a, a, measured, NOISE, threshold=2.0)
+    assert not never.decides
+    assert never.words().startswith("none of the next 3 modes' frequencies would tell")
