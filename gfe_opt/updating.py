@@ -652,12 +652,13 @@ REDUCED_BINDING = 1e-7
 class _Ldl:
     """The LDLᵀ factor of a quasi-definite matrix by QDLDL (approximate minimum-degree
     order, no pivoting), whose order and symbolic analysis the next matrix of the same
-    sparsity pattern reuses (:meth:`of`: a generic update's refinement steps, 3 a step at
-    2 000 elements: 22.7 ms with SuperLU, 13.6 ms a new factor, 4.3 ms a reused one;
-    ``python scripts/bench.py --parts fits``, README Speed).  SuperLU (the same
-    unpivoted factor in its own minimum-degree order) where QDLDL fails."""
+    sparsity pattern reuses (``previous``: a generic update's steps, 3 an update; at 2 000
+    elements 22.7 ms a factor with SuperLU, 13.6 ms a new one, 4.3 ms a reused one,
+    README Speed).  SuperLU (diagonal pivots where they are not zero, in its own
+    minimum-degree order) where QDLDL fails or on request (``superlu``: :func:`_solve_direct`
+    when the solve from QDLDL's factor stays inaccurate)."""
 
-    def __init__(self, matrix, previous=None):
+    def __init__(self, matrix, previous=None, superlu: bool = False):
         import qdldl
 
         matrix = sp.csc_matrix(matrix)
@@ -668,13 +669,16 @@ class _Ldl:
             np.array_equal(previous.pattern[2], matrix.indices)
         self.qdldl = self.superlu = None
         try:
+            if superlu:
+                raise RuntimeError("SuperLU asked for")
             if same and previous.qdldl is not None:
                 previous.qdldl.update(matrix)
                 self.qdldl, previous.qdldl = previous.qdldl, None
             else:
                 self.qdldl = qdldl.Solver(matrix)
-        except (ValueError, RuntimeError):   # a zero pivot to rounding: SuperLU's own order
-            # (RuntimeError: an exactly singular pivot, no regularisation; the caller's)
+        except (ValueError, RuntimeError):   # a zero pivot (or asked for): SuperLU, which
+            # pivots off a zero diagonal (its RuntimeError, an exactly singular matrix: the
+            # caller's)
             self.superlu = splu(matrix, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                                 options={"SymmetricMode": True})
 
@@ -701,7 +705,7 @@ class _Kkt:
     :meth:`solve` may border it by more equality rows F z = f (conditions held by
     :func:`_solve_reduced`), each solved against the factor once (:meth:`column`)."""
 
-    def __init__(self, pb: _Problem, previous: _Ldl | None = None):
+    def __init__(self, pb: _Problem, previous: _Ldl | None = None, superlu: bool = False):
         B, b, reg = _expanded_least_squares(pb)
         z0 = pb.x0 / pb.x_scale
         E, c = _energy_balance(pb)
@@ -717,7 +721,7 @@ class _Kkt:
         self.n_u, self.x_scale = b.size, pb.x_scale
         self.border = np.vstack([np.zeros((b.size, c.size)), E.T])
         self.rhs, self.rhs_eq = np.concatenate([-b, reg**2 * z0]), -c
-        self.lu = _Ldl(self.K, previous)
+        self.lu = _Ldl(self.K, previous, superlu)
         self.k_border = self.lu.solve(self.border)
 
     def column(self, row):
@@ -772,9 +776,14 @@ def _solve_direct(pb: _Problem, reuse: dict | None = None):
     try:
         kkt = _Kkt(pb, reuse.pop("factor", None))
         reuse["factor"] = kkt.lu
+        out = kkt.solve()
+        if out is None and kkt.lu.qdldl is not None:
+            # QDLDL's factor, unpivoted, solved it inaccurately (a pivot lost to rounding):
+            # SuperLU's, which pivots off a zero diagonal
+            kkt = _Kkt(pb, superlu=True)
+            out = kkt.solve()
     except RuntimeError:  # an exactly singular pivot (no regularisation)
         return None
-    out = kkt.solve()
     return None if out is None else (kkt, *out)
 
 

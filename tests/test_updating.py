@@ -347,3 +347,65 @@ def test_the_reduced_cone_program_is_ipopts_problem_and_starts_no_threads():
     f_conic, f_ipopt = 0.5 * conic["x"] @ conic["x"], 0.5 * ipopt["x"] @ ipopt["x"]
     assert abs(f_conic / f_ipopt - 1) < 1e-7                                 # 1.6e-10
     assert np.max(np.abs(conic["x"] - ipopt["x"])) < 1e-4 * np.max(np.abs(ipopt["x"]))  # 1.8e-6
+
+
+def _quasi_definite(rng, n_u=30, n_z=20, scale=1.0):
+    """[[-Q, B], [Bᵀ, R]] with Q, R symmetric positive definite and sparse (the generic
+    update's KKT system's shape)."""
+    import scipy.sparse as sp
+
+    def spd(n):
+        a = sp.random(n, n, density=0.1, random_state=rng)
+        return (a @ a.T + sp.identity(n)).tocsc()
+
+    B = sp.random(n_u, n_z, density=0.2, random_state=rng) * scale
+    return sp.bmat([[-spd(n_u), B], [B.T, spd(n_z)]], format="csc")
+
+
+def test_the_kkt_factor_solves_and_its_order_serves_the_next_matrix():
+    """The generic update's KKT factor (QDLDL, no pivoting: a quasi-definite matrix needs
+    none) solves to rounding; a second matrix of the same pattern (the update's next step)
+    reuses its order and solves that matrix, not the first; a matrix it cannot factor
+    without pivots (a zero diagonal) is solved by SuperLU."""
+    import scipy.sparse as sp
+
+    rng = np.random.default_rng(4)
+    A = _quasi_definite(rng)
+    b = rng.standard_normal(A.shape[0])
+    first = updating._Ldl(A)
+    assert first.qdldl is not None
+    x = first.solve(b)
+    assert np.linalg.norm(A @ x - b) < 1e-12 * np.linalg.norm(b)
+    A2 = A.copy()
+    A2.data = A2.data * (1.0 + 0.5 * rng.random(A2.data.size))   # same pattern, new values
+    A2 = 0.5 * (A2 + A2.T)
+    second = updating._Ldl(A2, first)
+    assert second.qdldl is not None and first.qdldl is None     # handed on, not rebuilt
+    X = second.solve(np.stack([b, 2 * b], axis=1))
+    assert np.linalg.norm(A2 @ X[:, 0] - b) < 1e-12 * np.linalg.norm(b)
+    assert np.allclose(X[:, 1], 2 * X[:, 0], rtol=1e-12, atol=0)
+    assert np.linalg.norm(A @ X[:, 0] - b) > 1e-3 * np.linalg.norm(b)
+    swap = sp.csc_matrix(np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 2.0]]))
+    third = updating._Ldl(swap)
+    assert third.qdldl is None and third.superlu is not None
+    assert np.allclose(third.solve(np.array([1.0, 2.0, 3.0])), [2.0, 1.0, 1.5])
+
+
+def test_an_inaccurate_ldl_solve_falls_back_to_superlu(monkeypatch):
+    """Where the solve from QDLDL's unpivoted factor stays inaccurate, the step is solved
+    from SuperLU's factor (not sent whole to IPOPT): the same update, to the KKT solve's
+    rounding."""
+    model = make_model(elements=20)
+    measured, shapes = _all_dof_data(model, _dip(model), 3)
+    plain = update_generic(model, measured, full_shapes=shapes, noise=0.0)
+    solve, used = updating._Kkt.solve, []
+
+    def refuse_ldl(self, *args):
+        used.append(self.lu.qdldl is None)
+        return None if self.lu.qdldl is not None else solve(self, *args)
+
+    monkeypatch.setattr(updating._Kkt, "solve", refuse_ldl)
+    fallback = update_generic(model, measured, full_shapes=shapes, noise=0.0)
+    assert plain.solver == fallback.solver == "direct"
+    assert used[:2] == [False, True]
+    assert np.allclose(fallback.q, plain.q, rtol=1e-8, atol=0)
