@@ -668,6 +668,8 @@ class _Ldl:
             np.array_equal(previous.pattern[1], matrix.indptr) and \
             np.array_equal(previous.pattern[2], matrix.indices)
         self.qdldl = self.superlu = None
+        if previous is not None and not same:
+            previous.qdldl = None   # (released before the new factor is made: memory)
         try:
             if superlu:
                 raise RuntimeError("SuperLU asked for")
