@@ -86,7 +86,8 @@ class Decision:
             parts.append(f"a sensor {_place_words(self.sensor)} would see them differ by "
                          f"{self.sensor_sigma:.1f} σ of the shape noise")
         if self.mode_decides:
-            parts.append(f"mode {self.mode} (about {self.mode_hz:.4g} Hz) would differ by "
+            hz = float(f"{self.mode_hz:.4g}")   # 4 digits, no exponent (18870 Hz)
+            parts.append(f"mode {self.mode} (about {hz:g} Hz) would differ by "
                          f"{self.mode_sigma:.1f} σ in frequency")
         if parts:
             return (" or ".join(parts) + " (the two fits' prediction as they stand: refitted "
