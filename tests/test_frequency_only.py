@@ -258,8 +258,8 @@ def test_a_stiffness_loss_that_fits_as_well_as_a_mass_is_said_beside_it():
     notch, and listed as indistinguishable in the JSON.  The mass is said alone, a
     confident wrong answer: the zone stands 4.05 behind by χ²/s² + p ln n (ALIKE_CHI2
     3.84), all of it its two parameters more.  Saying alike every fit within 3.84 floors
-    of χ² with more parameters fixes this case and adds 69 caveats to the two beam
-    campaigns, every one a zone that re-describes the finding (a 3 mm zone of a tenth the
+    of χ² with more parameters fixes this case and adds 67 caveats to the two beam
+    campaigns, nearly all a zone that re-describes the finding (a 3 mm zone of a tenth the
     stiffness for a crack, a 2 cm zone of three times the mass for a point mass, a zone
     over the beam for E): the rule needs a test of whether the two fits are one physical
     effect, not yet written."""
