@@ -2433,11 +2433,13 @@ def _undecided_note(fit, undecided, measured, held, judged,
                      if isinstance(e.parameters.get("position"), (int, float))})
     near = f" near x = {', '.join(f'{x:g}' for x in places)} m" if places else ""
     shapes = "mode shapes (sensors" + near + ") would decide"
-    decide = ("more modes, or sensors" + (near or " closer together") + " would decide"
-              if decision is None and not measured.frequency_only else shapes
-              if decision is None else decision.words() + (
-                  ("; or " if decision.decides else "; ") + shapes
-                  if measured.frequency_only else ""))
+    if decision is None:
+        decide = shapes if measured.frequency_only else \
+            "more modes, or sensors" + (near or " closer together") + " would decide"
+    elif measured.frequency_only:   # (its decision weighs the next modes only)
+        decide = decision.words() + ("; or " if decision.decides else "; ") + shapes
+    else:
+        decide = decision.words()
     return Caveat(f"not a finding: {what} fit {found} as well as {alternatives}, so they "
                   f"do not determine it; {refused} — {decide}", "undecided",
                   [effects[held:] for effects in undecided], decide=decision)

@@ -670,19 +670,22 @@ class _Ldl:
         self.qdldl = self.superlu = None
         if previous is not None and not same:
             previous.qdldl = None   # (released before the new factor is made: memory)
-        try:
-            if superlu:
-                raise RuntimeError("SuperLU asked for")
-            if same and previous.qdldl is not None:
-                previous.qdldl.update(matrix)
-                self.qdldl, previous.qdldl = previous.qdldl, None
-            else:
-                self.qdldl = qdldl.Solver(matrix)
-        except (ValueError, RuntimeError):   # a zero pivot (or asked for): SuperLU, which
-            # pivots off a zero diagonal (its RuntimeError, an exactly singular matrix: the
-            # caller's)
-            self.superlu = splu(matrix, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                                options={"SymmetricMode": True})
+        if not superlu:
+            try:
+                if same and previous.qdldl is not None:
+                    previous.qdldl.update(matrix)
+                    self.qdldl, previous.qdldl = previous.qdldl, None
+                else:
+                    self.qdldl = qdldl.Solver(matrix)
+                return
+            except (ValueError, RuntimeError):   # a zero pivot
+                self.qdldl = None
+                if previous is not None:
+                    previous.qdldl = None   # (its factor spoilt by the failed update)
+        # SuperLU pivots off a zero diagonal (its RuntimeError, an exactly singular matrix:
+        # the caller's)
+        self.superlu = splu(matrix, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                            options={"SymmetricMode": True})
 
     def solve(self, b):
         """x of A x = b (``b`` a vector or columns)."""
