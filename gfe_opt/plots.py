@@ -241,14 +241,17 @@ def structure_sketch(ax, length, supports=("pinned", "pinned"), *, sensors=None,
     for k, (effect, model, params, sigma, *bounds) in enumerate(findings):  # a pair: 2 levels
         effect.mark(ax, model, params, sigma, 0.35 + 0.5 * k, *bounds)
     found_at = [effect.position(params) for effect, _, params, *_ in findings]
+    raised = 0
     for k, (x, name) in enumerate(elsewhere):
         ax.plot([x], [0.35], marker="o", ms=9, mfc="none", mec="0.3", mew=1.2)
-        # above a finding's own label when it sits near the finding (another effect there)
-        near = any(isinstance(f, (int, float)) and abs(f - x) < 0.08 * length
+        # above a finding's own label where the two labels would meet (a label of ~25
+        # characters spans about a fifth of the bar), each such one a line above the last
+        near = any(isinstance(f, (int, float)) and abs(f - x) < 0.2 * length
                    for f in found_at)
         ax.annotate(f"or {name} here (fits as well)" if k == 0 else f"or {name}", (x, 0.35),
-                    textcoords="offset points", xytext=(0, 20 if near else 8), ha="center",
-                    fontsize=7, color="0.3")
+                    textcoords="offset points", xytext=(0, 20 + 10 * raised if near else 8),
+                    ha="center", fontsize=7, color="0.3")
+        raised += near
     for k, x in enumerate(deciding):
         ax.plot([x], [-0.35], marker="v", ms=8, mfc="none", mec="tab:blue", mew=1.2)
         ax.annotate("a sensor here would decide" if k == 0 else "", (x, -0.35),
