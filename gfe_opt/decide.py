@@ -22,11 +22,12 @@ The separation is said in σ with the place (or mode) where it is largest.  It t
 two models apart when its square exceeds :data:`~gfe_opt.diagnosis.ALIKE_CHI2` noise floors
 (the diagnosis's threshold, √(ALIKE_CHI2 × floor)), the χ² gap under which the diagnosis
 calls two fits alike: a reading that moves their χ² further apart than that would make the
-diagnosis choose.  Where no place and no next mode does, that is
-said instead, with the best σ and the σ needed.  A prediction of the two fits as they
-stand, not of the structure, and before either is refitted with the new reading: refitted,
-they may move closer (the portal's body of ``scripts/study_frame_body.py`` case 9201 needed
-the sensor said, then the one said next).
+diagnosis choose.  Where no place and no next mode does, that is said instead, with the
+best σ (the σ needed only in the JSON: it follows the noise floor, and with it the
+arithmetic).  A prediction of the two fits as they stand, not of the structure, and before
+either is refitted with the new reading: refitted, they may move closer (the portal's body
+of ``scripts/study_frame_body.py`` case 9201 needed the sensor said, then the one said
+next).
 """
 
 from __future__ import annotations
