@@ -2419,7 +2419,8 @@ def _undecided_note(fit, undecided, measured, held, judged,
     """The finding (the fit's effects after the ``held`` ones of the model), its
     alternatives and what measurement would decide (``refused``: what is not suggested;
     ``judged``: (noise, C, selection) of :func:`_decision` between the finding and its
-    first alternative, said where the test has shapes)."""
+    first alternative: one more sensor or the next modes, from frequencies alone the next
+    modes, then mode shapes)."""
     decision = _decision(fit.model, fit.model.with_effects(undecided[0], check=False),
                          measured, *judged)
     what = "the frequencies" if measured.frequency_only else "the data"
